@@ -1,0 +1,48 @@
+# Top-level entry points. Every target installs what is missing first (scripts/install-deps.sh).
+BUILD ?= build
+JOBS ?= $(shell nproc)
+SCENE ?= scenes/cornell_box.ray
+CMAKE_FLAGS ?=
+
+.PHONY: all deps configure build demo test bench install test-sanitize fuzz report clean
+
+all: build
+
+deps:
+	@./scripts/install-deps.sh
+
+configure: deps
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null
+
+build: configure
+	@cmake --build $(BUILD) -j $(JOBS)
+
+# Renders the default scene with Lightcuts, checks it against brute force at sampled
+# pixels, and prints the speed-up and error.
+demo: build
+	@mkdir -p out
+	@./$(BUILD)/lightcuts render $(SCENE) -o out/cornell_box.png --reference-pixels 256 --stats out/cornell_box.json
+
+test: build
+	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+bench: build
+	@./scripts/bench.sh
+
+install: build
+	@cmake --install $(BUILD)
+
+test-sanitize: deps
+	@cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLC_SANITIZE=ON -DLC_BUILD_BENCH=OFF >/dev/null
+	@cmake --build build-sanitize -j $(JOBS)
+	@cd build-sanitize && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ctest --output-on-failure -j $(JOBS) -LE slow
+
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	@./scripts/fuzz.sh $(FUZZ_SECONDS)
+
+report: build
+	@./$(BUILD)/lightcuts report -o docs/report.html
+
+clean:
+	rm -rf $(BUILD) build-sanitize build-fuzz

@@ -1,0 +1,82 @@
+#include "core/file_util.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace fs = std::filesystem;
+
+namespace lc {
+
+std::string readFile(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw Error("cannot read '" + path + "': it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open '" + path + "': " + std::strerror(errno));
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) throw Error("cannot read '" + path + "'");
+  return ss.str();
+}
+
+static std::string tempNameFor(const std::string& path) {
+  static std::atomic<unsigned> counter{0};
+  return path + ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++);
+}
+
+void writeFileAtomically(const std::string& path,
+                         const std::function<void(const std::string&)>& write) {
+  std::string tmp = tempNameFor(path);
+  try {
+    write(tmp);
+    // Flush to disk before the rename so a crash cannot leave an empty file behind.
+    int fd = ::open(tmp.c_str(), O_RDONLY);
+    if (fd < 0) throw Error("cannot write '" + path + "': " + std::strerror(errno));
+    int syncErr = ::fsync(fd) == 0 ? 0 : errno;
+    ::close(fd);
+    if (syncErr != 0 && syncErr != EINVAL)
+      throw Error("cannot write '" + path + "': " + std::strerror(syncErr));
+    if (std::rename(tmp.c_str(), path.c_str()) != 0)
+      throw Error("cannot write '" + path + "': " + std::strerror(errno));
+  } catch (...) {
+    std::remove(tmp.c_str());
+    throw;
+  }
+}
+
+void checkWritable(const std::string& path) {
+  if (path.empty()) throw Error("empty output path");
+  std::error_code ec;
+  if (fs::is_directory(path, ec))
+    throw Error("cannot write '" + path + "': it is a directory");
+  std::string tmp = tempNameFor(path);
+  int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+  if (fd < 0) throw Error("cannot write '" + path + "': " + std::strerror(errno));
+  ::close(fd);
+  ::unlink(tmp.c_str());
+}
+
+std::string fileExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  if (!ext.empty() && ext[0] == '.') ext = ext.substr(1);
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+std::string parentDir(const std::string& path) { return fs::path(path).parent_path().string(); }
+
+std::string resolveRelative(const std::string& baseDir, const std::string& path) {
+  if (path.empty() || fs::path(path).is_absolute() || baseDir.empty()) return path;
+  return (fs::path(baseDir) / path).lexically_normal().string();
+}
+
+}  // namespace lc

@@ -1,0 +1,29 @@
+// File helpers: reading whole files, atomic writes and early writability checks.
+#pragma once
+
+#include <functional>
+#include <string>
+
+namespace lc {
+
+// Reads a whole file; throws lc::Error naming the path when it cannot.
+std::string readFile(const std::string& path);
+
+// Writes `path` atomically: `write` fills a temporary file in the same directory,
+// which is then renamed over `path`. On any failure the temporary is removed, the old
+// file (if any) is untouched, and lc::Error is thrown.
+void writeFileAtomically(const std::string& path,
+                         const std::function<void(const std::string& tmpPath)>& write);
+
+// Throws lc::Error when a file could not be created at `path` (missing or unwritable
+// directory), so a long render fails before it starts rather than after.
+void checkWritable(const std::string& path);
+
+// Lower-case extension without the dot ("png"), or "" when there is none.
+std::string fileExtension(const std::string& path);
+
+// Directory part of a path ("" for a bare file name) and joining of relative paths.
+std::string parentDir(const std::string& path);
+std::string resolveRelative(const std::string& baseDir, const std::string& path);
+
+}  // namespace lc

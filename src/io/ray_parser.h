@@ -1,0 +1,26 @@
+// Reader for the SBT .ray scene format (see docs/SCENE_FORMAT.md). Produces a SceneDesc;
+// every error is an lc::Error carrying file:line:column and what was expected.
+#pragma once
+
+#include <string>
+
+#include "core/limits.h"
+#include "io/scene_desc.h"
+
+namespace lc::io {
+
+struct ParseOptions {
+  // Unknown keywords and blocks are skipped with a warning (SceneDesc::warnings)
+  // instead of being errors.
+  bool lenient = false;
+  Limits limits;
+};
+
+// Parses a .ray file. Relative paths inside (textures, obj_mesh) resolve against its directory.
+SceneDesc parseRayFile(const std::string& path, const ParseOptions& options = {});
+
+// Parses .ray text; `name` is used in error messages and `baseDir` resolves relative paths.
+SceneDesc parseRayString(const std::string& text, const std::string& name,
+                         const std::string& baseDir, const ParseOptions& options = {});
+
+}  // namespace lc::io
