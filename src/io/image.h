@@ -3,9 +3,12 @@
 // EXR keeps linear floats. Every write is atomic (temporary file, then rename).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
+#include "core/error.h"
+#include "core/limits.h"
 #include "core/math.h"
 
 namespace lc::io {
@@ -24,11 +27,41 @@ enum class ToneMap { Clamp, Srgb };
 
 // Writes by extension: .png .ppm .bmp (8-bit) or .exr (float). Throws lc::Error
 // (unknown extension, unwritable path) and leaves any existing file untouched on failure.
+// 8-bit: Clamp stores round(clamp(v, 0, 1) * 255); Srgb applies the sRGB OETF to the
+// clamped value first. EXR stores 32-bit float RGB (exact round trip), tonemap ignored.
+// NaN channels are written as 0 in every format.
 void writeImage(const std::string& path, const Image& image, ToneMap tonemap = ToneMap::Clamp);
 
+// What went wrong in readImage, so that callers (textures) can reword the message and
+// add the location that referred to the file.
+class ImageReadError : public Error {
+ public:
+  enum class Kind { Open, Decode, TooLarge };
+  ImageReadError(Kind kind, const std::string& path, const std::string& reason,
+                 const std::string& msg, int width = 0, int height = 0)
+      : Error(msg), kind(kind), path(path), reason(reason), width(width), height(height) {}
+  Kind kind;
+  std::string path;
+  std::string reason;     // strerror / stbi_failure_reason / OpenEXR's message
+  int width, height;      // the image size, for Kind::TooLarge
+};
+
 // Reads .exr as linear floats, and 8-bit formats (.png .jpg .bmp .tga .ppm .hdr) via stb_image:
-// 8-bit values become value/255 (linearised when srgb = true); .hdr stays linear.
-Image readImage(const std::string& path, bool srgb = false);
+// 8-bit values become value/255 (linearised when srgb = true); 16-bit PNG value/65535;
+// .hdr stays linear. Grey images expand to RGB, alpha is dropped. The size is checked
+// against maxPixels before the pixels are decoded. Throws ImageReadError:
+//   "cannot open 'path': No such file or directory"
+//   "cannot read image 'path': <decoder's reason>"
+//   "image 'path' is WxH = N pixels, more than the limit of M"
+Image readImage(const std::string& path, bool srgb = false,
+                uint64_t maxPixels = Limits{}.maxTexturePixels);
+
+// sRGB transfer functions on [0,1] (values outside are clamped).
+float srgbToLinear(float v);
+float linearToSrgb(float v);
+
+// The 8-bit value writeImage stores for a linear channel value.
+uint8_t quantize8(float v, ToneMap tonemap);
 
 // True for extensions writeImage accepts.
 bool isWritableImageExtension(const std::string& ext);
