@@ -116,6 +116,8 @@ struct LightDesc {
   float cutoffDegrees = 90;
   std::optional<float> coneAngleDegrees;  // full cone half-angle, UW form
   float penumbraDegrees = 0;
+  // spot_light `cutoff_distance` (UW form): no light beyond this distance from the light.
+  float cutoffDistance = kInf;
   SourceLoc loc;
 };
 

@@ -1,0 +1,1197 @@
+// Recursive-descent reader for .ray files (docs/SCENE_FORMAT.md). Transforms and groups
+// are parsed with an explicit stack instead of recursion, so nesting depth is bounded
+// only by Limits::maxNesting and never by the C++ stack.
+#include "io/ray_parser.h"
+
+#include <cfloat>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <unordered_map>
+
+#include "core/file_util.h"
+#include "io/obj_loader.h"
+#include "io/ray_lexer.h"
+
+namespace lc::io {
+
+namespace detail {
+
+// Appends an OBJ file's mesh as one object: its materials go to the end of
+// scene.materials and triangleMaterials are shifted to match, unless `overrideMaterial`
+// is set (an explicit `material` in obj_mesh), which then applies to the whole mesh.
+// `object` carries the transform, name and location; its kind/mesh/material are filled in.
+void appendObjMesh(SceneDesc& scene, ObjData&& obj, ObjectDesc object,
+                   std::optional<int> overrideMaterial, int defaultMaterial) {
+  MeshDesc mesh = std::move(obj.mesh);
+  if (overrideMaterial) {
+    mesh.triangleMaterials.clear();
+    mesh.vertexMaterials.clear();
+    object.material = *overrideMaterial;
+  } else {
+    int base = int(scene.materials.size());
+    int count = int(obj.materials.size());
+    auto shift = [&](std::vector<int>& ids) {
+      for (int& id : ids) {
+        if (id < 0 || id >= count)
+          throw Error(object.loc, "OBJ material index " + std::to_string(id) + " is out of range (" +
+                                      std::to_string(count) + " materials)");
+        id += base;
+      }
+    };
+    shift(mesh.triangleMaterials);
+    shift(mesh.vertexMaterials);
+    for (MaterialDesc& m : obj.materials) scene.materials.push_back(std::move(m));
+    // The object's own material is what a triangle without an entry would use.
+    object.material = count > 0 ? base : defaultMaterial;
+  }
+  object.kind = ShapeKind::Mesh;
+  object.mesh = int(scene.meshes.size());
+  scene.meshes.push_back(std::move(mesh));
+  scene.objects.push_back(std::move(object));
+  for (std::string& w : obj.warnings) scene.warnings.push_back(std::move(w));
+}
+
+}  // namespace detail
+
+namespace {
+
+std::string quoteChar(char c) { return std::string("'") + c + "'"; }
+
+bool oneOf(const std::string& w, std::initializer_list<const char*> words) {
+  for (const char* x : words)
+    if (w == x) return true;
+  return false;
+}
+
+bool isTransformWord(const Token& t) {
+  return t.kind == TokenKind::Ident && !t.quoted &&
+         (t.word == "translate" || t.word == "rotate" || t.word == "scale" || t.word == "transform");
+}
+
+bool isPrimitiveWord(const Token& t) {
+  if (t.kind != TokenKind::Ident || t.quoted) return false;
+  const std::string& w = t.word;
+  return w == "sphere" || w == "box" || w == "square" || w == "cylinder" || w == "cone" ||
+         w == "trimesh" || w == "obj_mesh";
+}
+
+bool isTopLevelOnlyWord(const Token& t) {
+  if (t.kind != TokenKind::Ident || t.quoted) return false;
+  const std::string& w = t.word;
+  return w == "camera" || w == "ambient_light" || w == "point_light" || w == "directional_light" ||
+         w == "spot_light" || w == "area_light" || w == "instant_radiosity";
+}
+
+class Parser {
+ public:
+  Parser(std::string_view text, const std::string& name, const std::string& baseDir,
+         const ParseOptions& options)
+      : lex_(text, name), baseDir_(baseDir), opt_(options) {
+    scene_.path = name;
+  }
+
+  SceneDesc run();
+
+ private:
+  // ---- errors -------------------------------------------------------------------------
+  [[noreturn]] void fail(const Token& t, const std::string& msg) const { throw Error(lex_.loc(t), msg); }
+  [[noreturn]] void expected(const std::string& what, const Token& got) const {
+    fail(got, "expected " + what + ", got " + got.describe());
+  }
+  std::string where(const Token& t) const {
+    return std::to_string(t.line) + ":" + std::to_string(t.column);
+  }
+  // An unknown attribute or item: an error, or with --lenient a warning and its value skipped.
+  void unknown(const Token& key, const std::string& context);
+  void skipValue();
+
+  // ---- tokens and values ----------------------------------------------------------------
+  Token expectPunct(char c) {
+    Token t = lex_.next();
+    if (!t.isPunct(c)) expected(quoteChar(c), t);
+    return t;
+  }
+  void expectEquals() { expectPunct('='); }
+  Token numberToken() {
+    Token t = lex_.next();
+    if (t.kind != TokenKind::Number) expected("a number", t);
+    return t;
+  }
+  // Values that round to FLT_MAX are fine; only what would round to infinity is not.
+  float toFloat(const Token& t) const {
+    if (std::fabs(t.number) >= double(FLT_MAX) + std::ldexp(1.0, 103))
+      fail(t, "number " + t.text + " is out of range for a float");
+    return float(t.number);
+  }
+  float floatValue() { return toFloat(numberToken()); }
+  // A float that must be >= 0 (or > 0 when `positive`); `what` names it in the message.
+  float nonNegative(const char* what, bool positive = false) {
+    Token t = numberToken();
+    float v = toFloat(t);
+    if (positive ? !(v > 0) : !(v >= 0))
+      fail(t, std::string(what) + (positive ? " must be > 0" : " must be >= 0") + ", got " + t.text);
+    return v;
+  }
+  uint64_t integerValue(const char* what, uint64_t max, const char* flag = nullptr);
+  bool boolValue() {
+    Token t = lex_.next();
+    if (t.kind != TokenKind::Bool) expected("true or false", t);
+    return t.boolean;
+  }
+  Token nameValue();
+  // "(a, b, ...)" with exactly n numbers; `open` receives the '(' token.
+  void tuple(int n, double* out, bool asFloat, Token* open = nullptr);
+  Vec3 vec3(Token* open = nullptr) {
+    double d[3];
+    tuple(3, d, true, open);
+    return Vec3(float(d[0]), float(d[1]), float(d[2]));
+  }
+  // "( item, item, ... )" calling item() for each entry.
+  void list(const std::function<void()>& item);
+  template <class F>
+  void block(const std::string& what, F&& onAttr);
+
+  ColorParam colorValue();
+  ScalarParam scalarValue();
+  TextureRef mapValue(const Token& mapKeyword);
+
+  // ---- scene items ------------------------------------------------------------------------
+  void header();
+  int materialValue(int baseIndex);
+  int materialBlock(int baseIndex);
+  void materialDecl();
+  LuminosityDesc luminosity(const Token& key);
+  void camera(const Token& kw);
+  void ambientLight(const Token& kw);
+  void light(const Token& kw);
+  void areaLight(const Token& kw);
+  void instantRadiosity(const Token& kw);
+  void node();
+  bool closeFrames();
+  Mat4 transformArgs(const Token& kw);
+  void pushFrame(bool group, const Mat4& xf, const Token& open);
+  void primitive(const Token& kw);
+  void trimesh(const Token& kw, ObjectDesc& obj);
+  void objMesh(const Token& kw, ObjectDesc& obj);
+  void addLight(LightDesc&& l, const Token& kw);
+  void checkMeshLimits(const Token& at, uint64_t vertices, uint64_t triangles) const;
+
+  Mat4 currentTransform() const { return frames_.empty() ? Mat4::identity() : frames_.back().xf; }
+
+  struct Frame {
+    bool group;
+    Mat4 xf;            // object-to-world for what is inside
+    int savedDefault;   // group: the default material to restore at its '}'
+    std::string what;   // "translate", ..., "group"
+    int line, column;
+  };
+
+  RayLexer lex_;
+  std::string baseDir_;
+  const ParseOptions& opt_;
+  SceneDesc scene_;
+  int defaultMat_ = 0;                           // index of the current default material
+  std::unordered_map<std::string, int> named_;   // declared material names
+  std::vector<Frame> frames_;                    // open transforms and groups
+  uint64_t totalVertices_ = 0, totalTriangles_ = 0;
+  Token cameraToken_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Values
+
+void Parser::tuple(int n, double* out, bool asFloat, Token* openOut) {
+  Token open = lex_.next();
+  if (!open.isPunct('(')) expected("'('", open);
+  int count = 0;
+  if (lex_.peek().isPunct(')')) {
+    lex_.next();
+  } else {
+    for (;;) {
+      Token t = lex_.next();
+      if (t.kind != TokenKind::Number) expected("a number", t);
+      if (count < n) out[count] = asFloat ? double(toFloat(t)) : t.number;
+      ++count;
+      Token sep = lex_.next();
+      if (sep.isPunct(')')) break;
+      if (!sep.isPunct(',')) expected("',' or ')'", sep);
+    }
+  }
+  if (count != n)
+    fail(open, "expected " + std::to_string(n) + " numbers, got " + std::to_string(count));
+  if (openOut) *openOut = open;
+}
+
+void Parser::list(const std::function<void()>& item) {
+  expectPunct('(');
+  if (lex_.peek().isPunct(')')) {
+    lex_.next();
+    return;
+  }
+  for (;;) {
+    item();
+    Token sep = lex_.next();
+    if (sep.isPunct(')')) return;
+    if (!sep.isPunct(',')) expected("',' or ')'", sep);
+  }
+}
+
+// Integers are re-read from their spelling so that 64-bit seeds keep every bit.
+uint64_t Parser::integerValue(const char* what, uint64_t max, const char* flag) {
+  Token t = numberToken();
+  uint64_t v = 0;
+  std::string_view s = t.text;
+  if (!s.empty() && s[0] == '+') s.remove_prefix(1);
+  bool digitsOnly = !s.empty() && s.find_first_not_of("0123456789") == std::string_view::npos;
+  if (digitsOnly) {
+    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc()) fail(t, std::string(what) + " " + t.text + " is too large");
+  } else if (t.number < 0) {
+    fail(t, std::string(what) + " must be >= 0, got " + t.text);
+  } else if (std::floor(t.number) != t.number || t.number >= 18446744073709551616.0) {
+    expected("an integer for " + std::string(what), t);
+  } else {
+    v = uint64_t(t.number);
+  }
+  if (v > max) {
+    std::string msg = std::string(what) + " " + t.text + " is more than the limit of " + std::to_string(max);
+    if (flag) msg += std::string(" (raise it with ") + flag + ")";
+    fail(t, msg);
+  }
+  return v;
+}
+
+// `name x`, `name = x` or `name = "x"` (the keyword is already read). Returns the name token.
+Token Parser::nameValue() {
+  if (lex_.peek().isPunct('=')) lex_.next();
+  Token t = lex_.next();
+  if (t.kind != TokenKind::Ident && t.kind != TokenKind::Bool) expected("a name", t);
+  return t;
+}
+
+// map("file") or map(file): a texture, path relative to the .ray file's directory.
+TextureRef Parser::mapValue(const Token& mapKeyword) {
+  expectPunct('(');
+  Token f = lex_.next();
+  if (f.kind != TokenKind::Ident) expected("a file name", f);
+  if (f.text.empty()) fail(f, "empty texture file name");
+  expectPunct(')');
+  TextureRef ref;
+  ref.path = resolveRelative(baseDir_, f.text);
+  ref.loc = lex_.loc(mapKeyword);
+  ref.srgb = false;  // .ray textures are read as value/255, like the course renderer
+  return ref;
+}
+
+// A colour: (r,g,b) or map("file"). With a map the constant is unused and left 0.
+ColorParam Parser::colorValue() {
+  const Token& t = lex_.peek();
+  if (t.isWord("map")) {
+    Token m = lex_.next();
+    return ColorParam{Color(0, 0, 0), mapValue(m)};
+  }
+  if (t.isPunct('(')) return ColorParam{vec3(), std::nullopt};
+  expected("a colour (r,g,b) or map(\"file\")", lex_.next());
+}
+
+// A scalar: a number or map("file") (the texture's mean channel).
+ScalarParam Parser::scalarValue() {
+  const Token& t = lex_.peek();
+  if (t.isWord("map")) {
+    Token m = lex_.next();
+    return ScalarParam{0, mapValue(m)};
+  }
+  if (t.kind == TokenKind::Number) return ScalarParam{floatValue(), std::nullopt};
+  expected("a number or map(\"file\")", lex_.next());
+}
+
+// "{ key ... }": calls onAttr(key) for each attribute name; onAttr reads the value and
+// returns false for a key it does not know. Semicolons between attributes are optional.
+template <class F>
+void Parser::block(const std::string& what, F&& onAttr) {
+  Token open = lex_.next();
+  if (!open.isPunct('{')) expected("'{' after " + what, open);
+  for (;;) {
+    const Token& t = lex_.peek();
+    if (t.isPunct('}')) {
+      lex_.next();
+      return;
+    }
+    if (t.isPunct(';')) {
+      lex_.next();
+      continue;
+    }
+    if (t.kind == TokenKind::End)
+      expected("'}' to close " + what + " opened at " + where(open), t);
+    if (t.kind != TokenKind::Ident) expected("an attribute name or '}' in " + what, t);
+    Token key = lex_.next();
+    if (!onAttr(key)) unknown(key, what);
+  }
+}
+
+void Parser::unknown(const Token& key, const std::string& context) {
+  std::string msg = "unknown keyword '" + key.text + "'";
+  if (!context.empty()) msg += " in " + context;
+  if (!opt_.lenient) fail(key, msg);
+  scene_.warnings.push_back(lex_.loc(key).str() + ": warning: " + msg + " (skipped)");
+  skipValue();
+}
+
+// Skips an unknown attribute's value: tokens up to the next ';' at the same level (eaten),
+// the '}' or ')' that closes the enclosing block (kept), or the end of a balanced {...}
+// (and a ';' right after it). Parentheses and braces must balance; no recursion.
+void Parser::skipValue() {
+  struct Open { char closer; Token tok; };
+  std::vector<Open> open;
+  for (;;) {
+    const Token& t = lex_.peek();
+    if (t.kind == TokenKind::End) {
+      if (open.empty()) return;
+      expected(quoteChar(open.back().closer) + " to match " + open.back().tok.describe() +
+                   " at " + where(open.back().tok),
+               t);
+    }
+    if (open.empty()) {
+      if (t.isPunct(';')) {
+        lex_.next();
+        return;
+      }
+      if (t.isPunct('}') || t.isPunct(')')) return;
+    }
+    Token k = lex_.next();
+    if (k.isPunct('(') || k.isPunct('{')) {
+      if (int(open.size()) >= opt_.limits.maxNesting)
+        fail(k, "nesting deeper than the limit of " + std::to_string(opt_.limits.maxNesting) +
+                    " levels (raise it with --max-nesting)");
+      open.push_back({k.punct == '(' ? ')' : '}', k});
+    } else if (k.isPunct(')') || k.isPunct('}')) {
+      if (k.punct != open.back().closer) expected(quoteChar(open.back().closer), k);
+      open.pop_back();
+      if (open.empty() && k.punct == '}') {
+        if (lex_.peek().isPunct(';')) lex_.next();
+        return;
+      }
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// Header and top level
+
+// "SBT-raytracer" NUMBER: any version number is accepted (files say 1.0 or 1.1).
+void Parser::header() {
+  Token h = lex_.next();
+  if (h.kind != TokenKind::Ident || h.quoted || h.text != "SBT-raytracer")
+    expected("the header 'SBT-raytracer 1.0'", h);
+  Token v = lex_.next();
+  if (v.kind != TokenKind::Number) expected("a version number after 'SBT-raytracer'", v);
+}
+
+// scene := header { item }; item := camera | lights | instant_radiosity | material_decl | node | ";"
+SceneDesc Parser::run() {
+  header();
+  scene_.materials.push_back(MaterialDesc{});  // index 0: the initial default (all 0, index 1)
+  for (;;) {
+    const Token& t = lex_.peek();
+    if (t.kind == TokenKind::End) break;
+    if (t.isPunct(';')) {
+      lex_.next();
+      continue;
+    }
+    if (t.isPunct('}')) fail(t, "unexpected '}' (no block is open)");
+    if (t.isPunct('{') || isTransformWord(t) || isPrimitiveWord(t)) {
+      node();
+      continue;
+    }
+    if (t.kind != TokenKind::Ident) expected("a scene item (camera, light, material or object)", lex_.next());
+    const std::string w = t.quoted ? std::string() : t.word;
+    if (w == "material") {
+      materialDecl();
+      continue;
+    }
+    Token kw = lex_.next();
+    if (w == "camera") camera(kw);
+    else if (w == "ambient_light") ambientLight(kw);
+    else if (w == "point_light" || w == "directional_light" || w == "spot_light") light(kw);
+    else if (w == "area_light") areaLight(kw);
+    else if (w == "instant_radiosity") instantRadiosity(kw);
+    else unknown(kw, "");
+  }
+  return std::move(scene_);
+}
+
+// ---------------------------------------------------------------------------------------
+// Materials
+
+// material_decl := "material" "=" material   (top level or in a group)
+// Sets the default material that later blocks start from, for the rest of the file or
+// of the enclosing group.
+void Parser::materialDecl() {
+  lex_.next();  // "material"
+  expectEquals();
+  defaultMat_ = materialValue(defaultMat_);
+}
+
+// material := "{" { mat_attr } "}" | IDENT (a declared name). Returns its index.
+int Parser::materialValue(int baseIndex) {
+  const Token& t = lex_.peek();
+  if (t.isPunct('{')) return materialBlock(baseIndex);
+  if (t.kind == TokenKind::Ident) {
+    Token n = lex_.next();
+    auto it = named_.find(n.text);
+    if (it == named_.end()) fail(n, "unknown material '" + n.text + "'");
+    return it->second;
+  }
+  expected("a material block '{...}' or a material name", lex_.next());
+}
+
+// A material block. Starts as a copy of the material at `baseIndex` (the current default;
+// its name is not copied) and overrides what it lists:
+//   emissive, ambient, diffuse, specular, reflective, transmissive = (r,g,b) | map("file")
+//                           default (0,0,0); `emissive` also sets emissiveSet
+//   shininess = s | map()   Phong exponent >= 0, default 0
+//   index = s | map()       refractive index > 0, default 1
+//   name x | name = "x"     declares the material for later `material = x`
+//   luminosity = { ... }    makes objects with this material lights (see luminosity())
+int Parser::materialBlock(int baseIndex) {
+  MaterialDesc m = scene_.materials[size_t(baseIndex)];
+  m.name.clear();
+  m.loc = lex_.loc(lex_.peek());
+  block("material", [&](const Token& k) {
+    const std::string& w = k.word;
+    auto colour = [&](ColorParam& c) {
+      expectEquals();
+      c = colorValue();
+    };
+    if (w == "emissive") {
+      colour(m.emissive);
+      m.emissiveSet = true;
+    } else if (w == "ambient") {
+      colour(m.ambient);
+    } else if (w == "diffuse") {
+      colour(m.diffuse);
+    } else if (w == "specular") {
+      colour(m.specular);
+    } else if (w == "reflective") {
+      colour(m.reflective);
+    } else if (w == "transmissive") {
+      colour(m.transmissive);
+    } else if (w == "shininess" || w == "index") {
+      expectEquals();
+      Token vt = lex_.peek();
+      ScalarParam s = scalarValue();
+      if (w == "shininess" && !s.map && !(s.value >= 0))
+        fail(vt, "shininess must be >= 0, got " + vt.text);
+      if (w == "index" && !s.map && !(s.value > 0)) fail(vt, "index must be > 0, got " + vt.text);
+      (w == "shininess" ? m.shininess : m.index) = s;
+    } else if (w == "name") {
+      Token at = nameValue();
+      const std::string& n = at.text;
+      if (!n.empty()) {
+        auto it = named_.find(n);
+        if (it != named_.end())
+          fail(at, "material '" + n + "' is already declared (at " +
+                       scene_.materials[size_t(it->second)].loc.str() + ")");
+      }
+      m.name = n;
+    } else if (w == "luminosity") {
+      m.luminosity = luminosity(k);
+    } else {
+      return false;
+    }
+    return true;
+  });
+  int index = int(scene_.materials.size());
+  if (!m.name.empty()) named_[m.name] = index;
+  scene_.materials.push_back(std::move(m));
+  return index;
+}
+
+// luminosity = { colour|color = (r,g,b) | map("file") | texture;   default (1,1,1)
+//                intensity = total power >= 0 (default 1);
+//                density = point lights per unit area >= 0 (default 1);
+//                constant/linear/quadratic_attenuation_coeff >= 0 (default 0, 0, 1); }
+// Starts from these defaults (not from the default material's luminosity).
+LuminosityDesc Parser::luminosity(const Token& key) {
+  expectEquals();
+  LuminosityDesc l;
+  l.loc = lex_.loc(key);
+  block("luminosity", [&](const Token& k) {
+    const std::string& w = k.word;
+    if (!oneOf(w, {"color", "intensity", "density", "constant_attenuation_coeff",
+                   "linear_attenuation_coeff", "quadratic_attenuation_coeff"}))
+      return false;
+    expectEquals();
+    if (w == "color") {
+      if (lex_.peek().isWord("texture")) {
+        lex_.next();
+        l.colour = ColorParam{Color(1, 1, 1), std::nullopt};
+        l.colourFromDiffuse = true;
+      } else {
+        l.colour = colorValue();
+        l.colourFromDiffuse = false;
+      }
+    } else if (w == "intensity") {
+      l.intensity = nonNegative("intensity");
+    } else if (w == "density") {
+      l.density = nonNegative("density");
+    } else if (w == "constant_attenuation_coeff") {
+      l.attenConstant = nonNegative("constant_attenuation_coeff");
+    } else if (w == "linear_attenuation_coeff") {
+      l.attenLinear = nonNegative("linear_attenuation_coeff");
+    } else if (w == "quadratic_attenuation_coeff") {
+      l.attenQuadratic = nonNegative("quadratic_attenuation_coeff");
+    } else {
+      return false;
+    }
+    return true;
+  });
+  return l;
+}
+
+// ---------------------------------------------------------------------------------------
+// Camera and lights
+
+// camera { position = (x,y,z)        default (0,0,0)
+//          viewdir = (x,y,z)         default (0,0,-1)
+//          updir = (x,y,z)           default (0,1,0)
+//          look_at = (x,y,z)         viewdir = look_at - position (resolved at the '}')
+//          quaternion = (x,y,z,w)    rotates the default frame (-z view, +y up)
+//          fov = degrees             vertical, 0 < fov < 180, default 53.13
+//          aspectratio = w/h         > 0, default from the image size }
+// The last of viewdir / look_at / quaternion decides the view direction.
+void Parser::camera(const Token& kw) {
+  if (scene_.hasCamera)
+    fail(kw, "a second camera (the first is at " + where(cameraToken_) + ")");
+  CameraDesc c;
+  c.loc = lex_.loc(kw);
+  Vec3 lookAt;  // (a plain flag rather than std::optional: GCC warns on optional<Vec3>)
+  bool haveLookAt = false;
+  Token viewTok = kw, upTok = kw, lookTok;
+  block("camera", [&](const Token& k) {
+    const std::string& w = k.word;
+    if (!oneOf(w, {"position", "viewdir", "updir", "look_at", "quaternion", "fov", "aspectratio"}))
+      return false;
+    expectEquals();
+    if (w == "position") {
+      c.position = vec3();
+    } else if (w == "viewdir") {
+      c.viewDir = vec3(&viewTok);
+      if (length2(c.viewDir) == 0) fail(viewTok, "viewdir must not be zero");
+      haveLookAt = false;
+    } else if (w == "updir") {
+      c.upDir = vec3(&upTok);
+      if (length2(c.upDir) == 0) fail(upTok, "updir must not be zero");
+    } else if (w == "look_at") {
+      lookAt = vec3(&lookTok);
+      haveLookAt = true;
+    } else if (w == "quaternion") {
+      Token open;
+      double q[4];
+      tuple(4, q, false, &open);
+      double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+      if (!(n > 0) || !std::isfinite(n)) fail(open, "quaternion must not be zero");
+      double x = q[0] / n, y = q[1] / n, z = q[2] / n, qw = q[3] / n;
+      // Columns of the rotation matrix: view = R (0,0,-1), up = R (0,1,0).
+      c.viewDir = Vec3(float(-2 * (x * z + y * qw)), float(-2 * (y * z - x * qw)),
+                       float(-(1 - 2 * (x * x + y * y))));
+      c.upDir = Vec3(float(2 * (x * y - z * qw)), float(1 - 2 * (x * x + z * z)),
+                     float(2 * (y * z + x * qw)));
+      viewTok = upTok = open;
+      haveLookAt = false;
+    } else if (w == "fov") {
+      Token t = numberToken();
+      float f = toFloat(t);
+      if (!(f > 0 && f < 180)) fail(t, "fov must be between 0 and 180 degrees, got " + t.text);
+      c.fovDegrees = f;
+    } else if (w == "aspectratio") {
+      c.aspectRatio = nonNegative("aspectratio", true);
+    } else {
+      return false;
+    }
+    return true;
+  });
+  if (haveLookAt) {
+    c.viewDir = lookAt - c.position;
+    if (length2(c.viewDir) == 0) fail(lookTok, "look_at must differ from the camera position");
+    viewTok = lookTok;
+  }
+  Vec3 v = normalize(c.viewDir), u = normalize(c.upDir);
+  if (!(length(cross(v, u)) > 1e-6f)) {
+    const Token& at = (upTok.line > viewTok.line ||
+                       (upTok.line == viewTok.line && upTok.column > viewTok.column))
+                          ? upTok
+                          : viewTok;
+    fail(at, "viewdir and updir are parallel");
+  }
+  scene_.camera = c;
+  scene_.hasCamera = true;
+  cameraToken_ = kw;
+}
+
+// ambient_light { colour|color = (r,g,b); }   default (1,1,1); all ambient lights add up.
+void Parser::ambientLight(const Token& kw) {
+  Color c(1, 1, 1);
+  block("ambient_light", [&](const Token& k) {
+    if (k.word != "color") return false;
+    expectEquals();
+    c = vec3();
+    return true;
+  });
+  scene_.ambient += c;
+}
+
+void Parser::addLight(LightDesc&& l, const Token& kw) {
+  if (scene_.lights.size() >= opt_.limits.maxLights)
+    fail(kw, "more lights than the limit of " + std::to_string(opt_.limits.maxLights) +
+                 " (raise it with --max-lights)");
+  scene_.lights.push_back(std::move(l));
+}
+
+// point_light       { position = (0,0,0); colour = (1,1,1); attenuation coefficients }
+// directional_light { direction = (0,0,-1) (where the light travels); colour = (1,1,1) }
+// spot_light        { position; direction | target = point; colour; attenuation coefficients;
+//                     exponent = e >= 0 (default 0): falloff max(0, cos)^e;
+//                     cutoff = degrees in (0,180] (default 90): dark beyond;
+//                     cone_angle = degrees in (0,180] (half-angle); penumbra = degrees >= 0;
+//                     size = full cone angle in degrees (cone_angle = size/2);
+//                     blend = 0..1 (penumbra = blend * cone angle, applied at the '}');
+//                     cutoff_distance = d > 0: no light beyond d (default infinite) }
+// Attenuation: constant/linear/quadratic_attenuation_coeff >= 0, default 0, 0, 1
+// (point and spot lights). The last of direction / target decides the spot axis.
+void Parser::light(const Token& kw) {
+  const std::string kind = kw.word;
+  LightDesc l;
+  l.kind = kind == "point_light" ? LightKind::Point
+           : kind == "spot_light" ? LightKind::Spot
+                                  : LightKind::Directional;
+  l.loc = lex_.loc(kw);
+  bool positional = l.kind != LightKind::Directional, spot = l.kind == LightKind::Spot;
+  Vec3 target;
+  bool haveTarget = false;
+  std::optional<float> size, blend;
+  Token targetTok, blendTok;
+  block(kind, [&](const Token& k) {
+    const std::string& w = k.word;
+    if (w == "color") {
+      expectEquals();
+      l.colour = vec3();
+    } else if (w == "position" && positional) {
+      expectEquals();
+      l.position = vec3();
+    } else if (w == "direction" && (spot || !positional)) {
+      expectEquals();
+      Token open;
+      l.direction = vec3(&open);
+      if (length2(l.direction) == 0) fail(open, "direction must not be zero");
+      haveTarget = false;
+    } else if (w == "target" && spot) {
+      expectEquals();
+      target = vec3(&targetTok);
+      haveTarget = true;
+    } else if (w == "constant_attenuation_coeff" && positional) {
+      expectEquals();
+      l.attenConstant = nonNegative("constant_attenuation_coeff");
+    } else if (w == "linear_attenuation_coeff" && positional) {
+      expectEquals();
+      l.attenLinear = nonNegative("linear_attenuation_coeff");
+    } else if (w == "quadratic_attenuation_coeff" && positional) {
+      expectEquals();
+      l.attenQuadratic = nonNegative("quadratic_attenuation_coeff");
+    } else if (w == "exponent" && spot) {
+      expectEquals();
+      l.exponent = nonNegative("exponent");
+    } else if ((w == "cutoff" || w == "cone_angle") && spot) {
+      expectEquals();
+      Token t = numberToken();
+      float a = toFloat(t);
+      if (!(a > 0 && a <= 180)) fail(t, w + " must be in (0, 180] degrees, got " + t.text);
+      if (w == "cutoff") l.cutoffDegrees = a;
+      else l.coneAngleDegrees = a;
+    } else if (w == "penumbra" && spot) {
+      expectEquals();
+      l.penumbraDegrees = nonNegative("penumbra");
+    } else if (w == "size" && spot) {
+      expectEquals();
+      Token t = numberToken();
+      float s = toFloat(t);
+      if (!(s > 0 && s <= 360)) fail(t, "size must be in (0, 360] degrees, got " + t.text);
+      size = s;
+    } else if (w == "blend" && spot) {
+      expectEquals();
+      blendTok = numberToken();
+      float b = toFloat(blendTok);
+      if (!(b >= 0 && b <= 1)) fail(blendTok, "blend must be in [0, 1], got " + blendTok.text);
+      blend = b;
+    } else if (w == "cutoff_distance" && spot) {
+      expectEquals();
+      l.cutoffDistance = nonNegative("cutoff_distance", true);
+    } else {
+      return false;
+    }
+    return true;
+  });
+  if (haveTarget) {
+    l.direction = target - l.position;
+    if (length2(l.direction) == 0) fail(targetTok, "target must differ from the light position");
+  }
+  if (size) l.coneAngleDegrees = *size / 2;
+  if (blend) {
+    if (!l.coneAngleDegrees) fail(blendTok, "blend needs size or cone_angle");
+    l.penumbraDegrees = *blend * *l.coneAngleDegrees;
+  }
+  addLight(std::move(l), kw);
+}
+
+// area_light { position = corner (default (0,0,0)); u = edge; v = edge (both required);
+//              colour|color = (r,g,b) (default (1,1,1)); }
+// Becomes a two-triangle mesh object (corner, +u, +u+v, +v) in world space whose material
+// is a copy of the current default with diffuse 0 and
+// luminosity { colour = the colour; intensity = 1; density = 1 }.
+void Parser::areaLight(const Token& kw) {
+  Vec3 corner(0, 0, 0), u, v;
+  Color colour(1, 1, 1);
+  bool haveU = false, haveV = false;
+  block("area_light", [&](const Token& k) {
+    const std::string& w = k.word;
+    if (w != "position" && w != "u" && w != "v" && w != "color") return false;
+    expectEquals();
+    Vec3 x = vec3();
+    if (w == "position") corner = x;
+    else if (w == "u") u = x, haveU = true;
+    else if (w == "v") v = x, haveV = true;
+    else colour = x;
+    return true;
+  });
+  if (!haveU || !haveV) fail(kw, "area_light needs both u and v");
+  if (!(length(cross(u, v)) > 1e-6f * length(u) * length(v)))
+    fail(kw, "area_light has zero area (u and v are parallel or zero)");
+  checkMeshLimits(kw, 4, 2);
+  MeshDesc mesh;
+  mesh.points = {corner, corner + u, corner + u + v, corner + v};
+  mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  totalVertices_ += 4;
+  totalTriangles_ += 2;
+
+  MaterialDesc m = scene_.materials[size_t(defaultMat_)];
+  m.name.clear();
+  m.diffuse = ColorParam{};
+  LuminosityDesc lum;
+  lum.colour = ColorParam{colour, std::nullopt};
+  lum.intensity = 1;
+  lum.loc = lex_.loc(kw);
+  m.luminosity = lum;
+  m.loc = lex_.loc(kw);
+
+  ObjectDesc obj;
+  obj.kind = ShapeKind::Mesh;
+  obj.material = int(scene_.materials.size());
+  scene_.materials.push_back(std::move(m));
+  obj.mesh = int(scene_.meshes.size());
+  scene_.meshes.push_back(std::move(mesh));
+  obj.loc = lex_.loc(kw);
+  scene_.objects.push_back(std::move(obj));
+}
+
+// instant_radiosity { vpls = n >= 0 (at most --max-vpls); bounces = n >= 0;
+//                     normalize = "power" | "object"; clamp = c >= 0; seed = 64-bit integer; }
+// Every field is optional; command-line flags override. A second block updates the first.
+void Parser::instantRadiosity(const Token& kw) {
+  InstantRadiosityDesc ir = scene_.instantRadiosity.value_or(InstantRadiosityDesc{});
+  ir.loc = lex_.loc(kw);
+  block("instant_radiosity", [&](const Token& k) {
+    const std::string& w = k.word;
+    if (!oneOf(w, {"vpls", "bounces", "normalize", "clamp", "seed"})) return false;
+    expectEquals();
+    if (w == "vpls") {
+      ir.vpls = int(integerValue("vpls", std::min<uint64_t>(opt_.limits.maxVpls, INT32_MAX),
+                                 "--max-vpls"));
+    } else if (w == "bounces") {
+      ir.bounces = int(integerValue("bounces", 1000));
+    } else if (w == "normalize") {
+      Token t = lex_.next();
+      if (t.kind != TokenKind::Ident || (t.text != "power" && t.text != "object"))
+        expected("\"power\" or \"object\" for normalize", t);
+      ir.normalize = t.text;
+    } else if (w == "clamp") {
+      ir.clamp = nonNegative("clamp");
+    } else if (w == "seed") {
+      ir.seed = integerValue("seed", UINT64_MAX);
+    } else {
+      return false;
+    }
+    return true;
+  });
+  scene_.instantRadiosity = ir;
+}
+
+// ---------------------------------------------------------------------------------------
+// Nodes: transforms, groups and primitives
+
+void Parser::pushFrame(bool group, const Mat4& xf, const Token& open) {
+  if (int(frames_.size()) >= opt_.limits.maxNesting)
+    fail(open, "nesting deeper than the limit of " + std::to_string(opt_.limits.maxNesting) +
+                   " levels (raise it with --max-nesting)");
+  frames_.push_back(Frame{group, xf, defaultMat_, group ? "group" : open.text, open.line, open.column});
+}
+
+// node := primitive | transform | "{" { node | material_decl | ";" } "}"
+// Descends through transforms and groups by pushing frames; closeFrames() then consumes
+// the ')' and '}' that follow a finished node.
+void Parser::node() {
+  for (;;) {
+    Token t = lex_.next();
+    if (isTransformWord(t)) {
+      Mat4 m = transformArgs(t);
+      Mat4 xf = currentTransform() * m;
+      if (!xf.isFinite()) fail(t, "transform overflows (the accumulated matrix is not finite)");
+      pushFrame(false, xf, t);
+      continue;  // its child node follows
+    }
+    if (t.isPunct('{')) {
+      pushFrame(true, currentTransform(), t);
+    } else if (isPrimitiveWord(t)) {
+      primitive(t);
+    } else if (t.kind == TokenKind::Ident && !isTopLevelOnlyWord(t) && t.word != "material") {
+      unknown(t, "");  // lenient: the unknown object is skipped
+    } else {
+      expected("a primitive, transform or '{'", t);
+    }
+    if (!closeFrames()) return;
+  }
+}
+
+// Called after a complete node (or a '{'). Closes finished transforms with ')' and reads
+// the items of the innermost open group. Returns true when that group continues with
+// another node, false when the outermost node is complete.
+bool Parser::closeFrames() {
+  while (!frames_.empty()) {
+    Frame& f = frames_.back();
+    if (!f.group) {
+      Token c = lex_.next();
+      if (!c.isPunct(')'))
+        expected("')' to close " + f.what + " opened at " + std::to_string(f.line) + ":" +
+                     std::to_string(f.column),
+                 c);
+      frames_.pop_back();
+      continue;
+    }
+    for (;;) {
+      const Token& t = lex_.peek();
+      if (t.isPunct(';')) {
+        lex_.next();
+      } else if (t.isWord("material")) {
+        materialDecl();  // the group's default, until its '}'
+      } else if (t.isPunct('}')) {
+        lex_.next();
+        defaultMat_ = f.savedDefault;
+        frames_.pop_back();
+        break;
+      } else if (t.kind == TokenKind::End) {
+        expected("'}' to close the group opened at " + std::to_string(f.line) + ":" +
+                     std::to_string(f.column),
+                 t);
+      } else {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+// transform := "translate" "(" x "," y "," z ","
+//            | "rotate" "(" ax "," ay "," az "," radians ","     axis normalised, not zero
+//            | "scale" "(" s ","  |  "scale" "(" sx "," sy "," sz ","   factors not zero
+//            | "transform" "(" row "," row "," row "," row ","   4x4 row-major, last row 0 0 0 1
+// followed by the child node and ")". Reads up to and including the ',' before the child.
+Mat4 Parser::transformArgs(const Token& kw) {
+  const std::string& w = kw.word;
+  expectPunct('(');
+  auto arg = [&](Token* tok = nullptr) {
+    Token t = numberToken();
+    expectPunct(',');
+    if (tok) *tok = t;
+    return t.number;
+  };
+  if (w == "translate") {
+    double x = arg(), y = arg(), z = arg();
+    return Mat4::translate(x, y, z);
+  }
+  if (w == "rotate") {
+    Token axisTok;
+    double ax = arg(&axisTok), ay = arg(), az = arg(), angle = arg();
+    double len = std::sqrt(ax * ax + ay * ay + az * az);
+    if (!(len > 0) || !std::isfinite(len)) fail(axisTok, "rotate axis must not be zero");
+    return Mat4::rotate(ax / len, ay / len, az / len, angle);
+  }
+  if (w == "scale") {
+    Token t[3];
+    double s[3];
+    s[0] = arg(&t[0]);
+    if (lex_.peek().kind == TokenKind::Number) {
+      s[1] = arg(&t[1]);
+      s[2] = arg(&t[2]);
+    } else {
+      s[1] = s[2] = s[0];
+      t[1] = t[2] = t[0];
+    }
+    for (int i = 0; i < 3; ++i)
+      if (s[i] == 0) fail(t[i], "scale factor must not be zero (the transform would be singular)");
+    return Mat4::scale(s[0], s[1], s[2]);
+  }
+  // "transform": four rows of four numbers
+  Mat4 m;
+  Token rowTok[4];
+  for (int r = 0; r < 4; ++r) {
+    double row[4];
+    tuple(4, row, false, &rowTok[r]);
+    for (int c = 0; c < 4; ++c) m.m[size_t(r)][size_t(c)] = row[c];
+    expectPunct(',');
+  }
+  if (m.m[3][0] != 0 || m.m[3][1] != 0 || m.m[3][2] != 0 || m.m[3][3] != 1)
+    fail(rowTok[3], "the last row of a transform must be (0,0,0,1)");
+  if (m.det3() == 0) fail(kw, "transform matrix is singular");
+  return m;
+}
+
+// Every primitive: material = {...} | name;  name = x (kept in ObjectDesc::name).
+//   sphere    radius 1 at the origin
+//   box       the cube [-0.5,0.5]^3
+//   square    [-0.5,0.5]^2 in z = 0, normal +z
+//   cylinder  radius 1 about z, z in [0,1]; capped = true|false (default true)
+//   cone      along +z: height > 0 (1), bottom_radius >= 0 (1), top_radius >= 0 (0),
+//             capped (true); the radii must not both be 0
+//   trimesh / polymesh, obj_mesh: see trimesh() and objMesh()
+void Parser::primitive(const Token& kw) {
+  ObjectDesc obj;
+  obj.transform = currentTransform();
+  obj.material = defaultMat_;
+  obj.loc = lex_.loc(kw);
+  const std::string& w = kw.word;
+  if (w == "trimesh") return trimesh(kw, obj);
+  if (w == "obj_mesh") return objMesh(kw, obj);
+  obj.kind = w == "sphere" ? ShapeKind::Sphere
+             : w == "box"      ? ShapeKind::Box
+             : w == "square"   ? ShapeKind::Square
+             : w == "cylinder" ? ShapeKind::Cylinder
+                               : ShapeKind::Cone;
+  bool cyl = obj.kind == ShapeKind::Cylinder, cone = obj.kind == ShapeKind::Cone;
+  block(kw.text, [&](const Token& k) {
+    const std::string& a = k.word;
+    if (a == "material") {
+      expectEquals();
+      obj.material = materialValue(defaultMat_);
+    } else if (a == "name") {
+      obj.name = nameValue().text;
+    } else if (a == "capped" && (cyl || cone)) {
+      expectEquals();
+      obj.capped = boolValue();
+    } else if (a == "height" && cone) {
+      expectEquals();
+      obj.height = nonNegative("height", true);
+    } else if (a == "bottom_radius" && cone) {
+      expectEquals();
+      obj.bottomRadius = nonNegative("bottom_radius");
+    } else if (a == "top_radius" && cone) {
+      expectEquals();
+      obj.topRadius = nonNegative("top_radius");
+    } else {
+      return false;
+    }
+    return true;
+  });
+  if (cone && obj.bottomRadius == 0 && obj.topRadius == 0)
+    fail(kw, "cone has bottom_radius and top_radius both 0");
+  scene_.objects.push_back(std::move(obj));
+}
+
+void Parser::checkMeshLimits(const Token& at, uint64_t vertices, uint64_t triangles) const {
+  if (totalVertices_ + vertices > opt_.limits.maxVertices)
+    fail(at, "more vertices than the limit of " + std::to_string(opt_.limits.maxVertices) +
+                 " (raise it with --max-triangles)");
+  if (totalTriangles_ + triangles > opt_.limits.maxTriangles)
+    fail(at, "more triangles than the limit of " + std::to_string(opt_.limits.maxTriangles) +
+                 " (raise it with --max-triangles)");
+}
+
+// trimesh | polymesh {
+//   points = ((x,y,z), ...);        the vertices
+//   faces = ((i,j,k[,l...]), ...);  0-based; polygons become triangle fans (i,j,k),(i,k,l),...
+//   normals = ((x,y,z), ...);       one per point
+//   texture_uv | texcoords | tex_coords = ((u,v), ...);   one per point
+//   materials = ({...} | name, ...);   one per point; each block starts from the default
+//   gennormals; | gennormals = true|false;   compute smooth vertex normals
+//   material = ...; name = ...; }
+// Each list may be given once; semicolons after lists are optional. Face indices are
+// checked against the point count (when faces come first, at the '}').
+void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
+  MeshDesc mesh;
+  bool seen[5] = {false, false, false, false, false};  // points faces normals uvs materials
+  Token listTok[5];
+  struct Pos { int line, column; };
+  std::vector<Pos> deferred;  // index positions when faces precede points
+  bool pointsDone = false;
+  auto once = [&](int i, const Token& k) {
+    if (seen[i]) fail(k, "'" + k.text + "' is given twice in " + kw.text);
+    seen[i] = true;
+    listTok[i] = k;
+    expectEquals();
+  };
+  auto outOfRange = [&](long long idx, int line, int column) {
+    throw Error(lex_.loc(line, column), "face index " + std::to_string(idx) + " is out of range (the mesh has " +
+             std::to_string(mesh.points.size()) + " points)");
+  };
+
+  block(kw.text, [&](const Token& k) {
+    const std::string& a = k.word;
+    if (a == "material") {
+      expectEquals();
+      obj.material = materialValue(defaultMat_);
+    } else if (a == "name") {
+      obj.name = nameValue().text;
+    } else if (a == "gennormals") {
+      mesh.genNormals = true;
+      if (lex_.peek().isPunct('=')) {
+        lex_.next();
+        mesh.genNormals = boolValue();
+      }
+    } else if (a == "points") {
+      once(0, k);
+      list([&] {
+        Token open = lex_.peek();
+        checkMeshLimits(open, mesh.points.size() + 1, 0);
+        mesh.points.push_back(vec3());
+      });
+      pointsDone = true;
+    } else if (a == "faces") {
+      once(1, k);
+      std::vector<long long> poly;
+      std::vector<Pos> polyPos;
+      list([&] {
+        poly.clear();
+        polyPos.clear();
+        Token open = lex_.peek();
+        list([&] {
+          Token t = numberToken();
+          if (std::floor(t.number) != t.number || std::fabs(t.number) > 2147483647.0)
+            fail(t, "face index " + t.text + " is not an integer");
+          long long idx = (long long)t.number;
+          if (pointsDone && (idx < 0 || idx >= (long long)mesh.points.size()))
+            outOfRange(idx, t.line, t.column);
+          poly.push_back(idx);
+          polyPos.push_back({t.line, t.column});
+        });
+        if (poly.size() < 3)
+          fail(open, "a face needs at least 3 indices, got " + std::to_string(poly.size()));
+        checkMeshLimits(open, 0, mesh.triangles.size() + poly.size() - 2);
+        for (size_t i = 1; i + 1 < poly.size(); ++i) {
+          mesh.triangles.push_back({int(poly[0]), int(poly[i]), int(poly[i + 1])});
+          if (!pointsDone) {
+            deferred.push_back(polyPos[0]);
+            deferred.push_back(polyPos[i]);
+            deferred.push_back(polyPos[i + 1]);
+          }
+        }
+      });
+    } else if (a == "normals") {
+      once(2, k);
+      list([&] { mesh.normals.push_back(vec3()); });
+    } else if (a == "texture_uv") {
+      once(3, k);
+      list([&] {
+        double uv[2];
+        tuple(2, uv, true);
+        mesh.uvs.push_back(Vec2(float(uv[0]), float(uv[1])));
+      });
+    } else if (a == "materials") {
+      once(4, k);
+      list([&] { mesh.vertexMaterials.push_back(materialValue(defaultMat_)); });
+    } else {
+      return false;
+    }
+    return true;
+  });
+
+  if (mesh.points.empty() || mesh.triangles.empty()) fail(kw, kw.text + " needs points and faces");
+  // Faces read before the points are checked now, at each index's own position.
+  for (size_t i = 0; i < deferred.size(); ++i) {
+    int idx = mesh.triangles[i / 3][i % 3];
+    if (idx < 0 || size_t(idx) >= mesh.points.size()) outOfRange(idx, deferred[i].line, deferred[i].column);
+  }
+  auto perVertex = [&](int i, size_t n) {
+    if (seen[i] && n != mesh.points.size())
+      fail(listTok[i], kw.text + " has " + std::to_string(mesh.points.size()) + " points but " +
+                           std::to_string(n) + " " + listTok[i].text);
+  };
+  perVertex(2, mesh.normals.size());
+  perVertex(3, mesh.uvs.size());
+  perVertex(4, mesh.vertexMaterials.size());
+
+  totalVertices_ += mesh.points.size();
+  totalTriangles_ += mesh.triangles.size();
+  obj.kind = ShapeKind::Mesh;
+  obj.mesh = int(scene_.meshes.size());
+  scene_.meshes.push_back(std::move(mesh));
+  scene_.objects.push_back(std::move(obj));
+}
+
+// obj_mesh { file = "model.obj" (required, relative to the .ray file);
+//            material = ... (overrides the MTL materials); name = ...; }
+// The OBJ's MTL materials start from the current default material.
+void Parser::objMesh(const Token& kw, ObjectDesc& obj) {
+  std::string file;
+  std::optional<int> material;
+  block("obj_mesh", [&](const Token& k) {
+    const std::string& a = k.word;
+    if (a == "file") {
+      expectEquals();
+      Token f = lex_.next();
+      if (f.kind != TokenKind::Ident) expected("a file name", f);
+      if (f.text.empty()) fail(f, "empty file name");
+      file = f.text;
+    } else if (a == "material") {
+      expectEquals();
+      material = materialValue(defaultMat_);
+    } else if (a == "name") {
+      obj.name = nameValue().text;
+    } else {
+      return false;
+    }
+    return true;
+  });
+  if (file.empty()) fail(kw, "obj_mesh needs a file");
+  Limits remaining = opt_.limits;
+  remaining.maxTriangles -= std::min(remaining.maxTriangles, totalTriangles_);
+  remaining.maxVertices -= std::min(remaining.maxVertices, totalVertices_);
+  ObjData data = loadObj(resolveRelative(baseDir_, file), lex_.loc(kw),
+                         scene_.materials[size_t(defaultMat_)], remaining);
+  checkMeshLimits(kw, data.mesh.points.size(), data.mesh.triangles.size());
+  totalVertices_ += data.mesh.points.size();
+  totalTriangles_ += data.mesh.triangles.size();
+  detail::appendObjMesh(scene_, std::move(data), std::move(obj), material, defaultMat_);
+}
+
+}  // namespace
+
+SceneDesc parseRayString(const std::string& text, const std::string& name, const std::string& baseDir,
+                         const ParseOptions& options) {
+  if (text.size() > options.limits.maxFileBytes)
+    throw Error("'" + name + "' is larger than the limit of " + std::to_string(options.limits.maxFileBytes) +
+                " bytes");
+  Parser parser(text, name, baseDir, options);
+  return parser.run();
+}
+
+SceneDesc parseRayFile(const std::string& path, const ParseOptions& options) {
+  std::error_code ec;
+  auto size = std::filesystem::file_size(path, ec);
+  if (!ec && size > options.limits.maxFileBytes)
+    throw Error("'" + path + "' is larger than the limit of " + std::to_string(options.limits.maxFileBytes) +
+                " bytes");
+  std::string text = readFile(path);
+  return parseRayString(text, path, parentDir(path), options);
+}
+
+}  // namespace lc::io
