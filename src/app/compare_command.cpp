@@ -1,0 +1,77 @@
+// `lightcuts compare`: error metrics between a reference and a test image.
+#include <fmt/format.h>
+
+#include "app/commands.h"
+#include "core/file_util.h"
+#include "io/colormap.h"
+#include "io/image.h"
+#include "io/image_metrics.h"
+#include "io/obj_loader.h"
+
+namespace lc::app {
+
+namespace {
+
+struct CompareArgs {
+  std::string ref, test;
+  bool json = false;
+  std::string heatmap;
+  double threshold = 0.02;
+  float heatmapMax = 0.05f;
+};
+
+int runCompare(const CompareArgs& a) {
+  if (!a.heatmap.empty()) checkWritable(a.heatmap);
+  io::Image ref = io::readImage(a.ref), test = io::readImage(a.test);
+  io::ImageMetrics m = io::compareImages(ref, test, a.threshold);
+  if (!a.heatmap.empty()) {
+    io::Image hm = io::heatmap(io::relativeErrors(ref, test), ref.width, ref.height, 0, a.heatmapMax,
+                               fmt::format("relative error (0 .. {:g})", a.heatmapMax));
+    io::writeImage(a.heatmap, hm);
+  }
+  if (a.json) {
+    fmt::print("{}\n", io::metricsToJson(m));
+    return 0;
+  }
+  fmt::print("size                   {}x{}\n", m.width, m.height);
+  fmt::print("rmse                   {:.6g}\n", m.rmse);
+  fmt::print("relative rmse          {:.4g}\n", m.relative_rmse);
+  fmt::print("mean relative error    {:.4f}%\n", 100 * m.mean_relative_error);
+  fmt::print("p99 relative error     {:.4f}%\n", 100 * m.p99_relative_error);
+  fmt::print("pixels over {:g}%       {:.4f}%\n", 100 * a.threshold, 100 * m.fraction_over_2pct);
+  fmt::print("max abs error          {:.6g}\n", m.max_abs_error);
+  fmt::print("psnr                   {:.2f} dB\n", m.psnr);
+  fmt::print("(relative error = |lum(test) - lum(ref)| / max(lum(ref), {:.4g}), the floor being 1% of the mean)\n", m.floor);
+  return 0;
+}
+
+}  // namespace
+
+void addCompareCommand(CLI::App& app) {
+  auto a = std::make_shared<CompareArgs>();
+  CLI::App* c = app.add_subcommand("compare", "Error metrics of TEST against the reference REF (RMSE, relative errors, PSNR)");
+  c->add_option("ref", a->ref, "Reference image (.exr for exact values, or 8-bit)")->required();
+  c->add_option("test", a->test, "Test image, same size")->required();
+  c->add_flag("--json", a->json, "Print the metrics as JSON");
+  c->add_option("--heatmap", a->heatmap, "Write the per-pixel relative error, colour-mapped with a legend, to this PNG");
+  c->add_option("--heatmap-max", a->heatmapMax, "Relative error at the top of the heatmap's scale (default 0.05)")
+      ->check(CLI::Range(1e-6f, 1e6f));
+  c->add_option("--threshold", a->threshold, "Relative error counted by fraction_over_2pct (default 0.02)")
+      ->check(CLI::Range(0.0, 1e6));
+  c->callback([a] { exitStatus() = runCompare(*a); });
+}
+
+void addObj2RayCommand(CLI::App& app) {
+  auto in = std::make_shared<std::string>();
+  auto out = std::make_shared<std::string>();
+  CLI::App* c = app.add_subcommand("obj2ray", "Convert an OBJ/MTL model to an equivalent .ray scene");
+  c->add_option("input", *in, "OBJ file")->required();
+  c->add_option("-o,--output", *out, "Output .ray file")->required();
+  c->callback([in, out] {
+    io::writeRayFromObj(*in, *out, Limits{});
+    fmt::print("wrote {}\n", *out);
+    exitStatus() = 0;
+  });
+}
+
+}  // namespace lc::app

@@ -1,0 +1,95 @@
+// `lightcuts info`: what a scene holds, without rendering it.
+#include <fmt/format.h>
+
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "app/scene_loader.h"
+#include "app/scene_options.h"
+
+namespace lc::app {
+
+namespace {
+
+struct InfoArgs {
+  std::string scene;
+  bool json = false;
+  LoadOptions load;
+};
+
+const char* shapeName(io::ShapeKind k) {
+  switch (k) {
+    case io::ShapeKind::Sphere: return "sphere";
+    case io::ShapeKind::Box: return "box";
+    case io::ShapeKind::Square: return "square";
+    case io::ShapeKind::Cylinder: return "cylinder";
+    case io::ShapeKind::Cone: return "cone";
+    case io::ShapeKind::Mesh: return "trimesh";
+  }
+  return "?";
+}
+
+int runInfo(InfoArgs& a) {
+  a.load.quiet = true;
+  LoadedScene ls = loadScene(a.scene, a.load);
+  const scene::Scene& s = *ls.scene;
+  std::map<std::string, int> shapes;
+  for (const auto& sh : s.shapes()) ++shapes[shapeName(sh.kind)];
+  const LightSet& L = s.lights();
+  nlohmann::json j;
+  j["scene"] = a.scene;
+  j["objects"] = s.shapes().size();
+  j["objects_by_kind"] = shapes;
+  j["triangles"] = s.triangleCount();
+  j["materials"] = s.materials().size();
+  nlohmann::json lights;
+  for (int t = 0; t < kLightTypeCount; ++t) lights[lightTypeName(LightType(t))] = L.countOf(LightType(t));
+  lights["total"] = L.size();
+  j["lights"] = lights;
+  j["ambient"] = {s.ambient().x, s.ambient().y, s.ambient().z};
+  const Bounds3& b = s.bounds();
+  j["bounds"] = {{"min", {b.lo.x, b.lo.y, b.lo.z}}, {"max", {b.hi.x, b.hi.y, b.hi.z}}};
+  nlohmann::json objs = nlohmann::json::array();
+  for (const auto& o : ls.objectLights)
+    objs.push_back({{"shape", o.shape}, {"name", o.name}, {"lights", o.lights}, {"area", o.area},
+                    {"power", {o.power.x, o.power.y, o.power.z}}});
+  j["object_lights"] = objs;
+  j["vpls"] = ls.vpls.vpls;
+  if (a.json) {
+    fmt::print("{}\n", j.dump(2));
+    return 0;
+  }
+  fmt::print("scene      {}\n", a.scene);
+  std::string kinds;
+  for (const auto& [k, n] : shapes) kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", n, k);
+  fmt::print("objects    {} ({})\n", s.shapes().size(), kinds);
+  fmt::print("triangles  {}\n", s.triangleCount());
+  fmt::print("materials  {}\n", s.materials().size());
+  std::string lk;
+  for (int t = 0; t < kLightTypeCount; ++t)
+    if (size_t c = L.countOf(LightType(t))) lk += fmt::format("{}{} {}", lk.empty() ? "" : ", ", c, lightTypeName(LightType(t)));
+  fmt::print("lights     {}{}\n", L.size(), lk.empty() ? "" : " (" + lk + ")");
+  fmt::print("ambient    ({}, {}, {})\n", s.ambient().x, s.ambient().y, s.ambient().z);
+  if (!b.empty())
+    fmt::print("bounds     ({:.4g}, {:.4g}, {:.4g}) .. ({:.4g}, {:.4g}, {:.4g})\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);
+  for (const auto& o : ls.objectLights)
+    fmt::print("object light  #{} {}: {} lights over area {:.4g}, power ({:.4g}, {:.4g}, {:.4g})\n", o.shape,
+               o.name.empty() ? "(unnamed)" : o.name, o.lights, o.area, o.power.x, o.power.y, o.power.z);
+  if (ls.vpls.vpls) fmt::print("vpls       {} from {} paths\n", ls.vpls.vpls, ls.vpls.paths);
+  for (const std::string& w : ls.warnings) fmt::print("warning    {}\n", w);
+  return 0;
+}
+
+}  // namespace
+
+void addInfoCommand(CLI::App& app) {
+  auto a = std::make_shared<InfoArgs>();
+  CLI::App* c = app.add_subcommand("info", "Describe a scene: objects, triangles, materials, lights by kind, bounds");
+  c->add_option("scene", a->scene, "Scene file (.ray or .obj)")->required();
+  c->add_flag("--json", a->json, "Print JSON");
+  addSceneOptions(*c, a->load);
+  c->callback([a] { exitStatus() = runInfo(*a); });
+}
+
+}  // namespace lc::app

@@ -1,0 +1,297 @@
+// `lightcuts render`: load, light, render, write the image, report.
+#include <fmt/format.h>
+
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <thread>
+#include <nlohmann/json.hpp>
+
+#include "app/commands.h"
+#include "app/progress.h"
+#include "app/scene_loader.h"
+#include "app/scene_options.h"
+#include "core/file_util.h"
+#include "io/colormap.h"
+#include "io/image.h"
+#include "lightcuts/evaluator.h"
+#include "render/renderer.h"
+
+namespace lc::app {
+
+namespace {
+
+std::atomic<bool> gInterrupted{false};
+extern "C" void onSignal(int) { gInterrupted.store(true); }
+
+struct RenderArgs {
+  std::string scene;
+  std::string out;
+  int width = 0, height = 0;
+  int spp = 1;
+  int threads = 0;
+  int maxDepth = 5;
+  std::string stats;
+  bool quiet = false;
+  std::string method = "lightcuts";
+  std::string tree;  // default: by method
+  float error = -1;  // default: by method
+  int maxCut = 1000;
+  std::string cutHeatmap;
+  int referencePixels = 0;
+  std::string tonemap = "clamp";
+  uint64_t seed = 1;
+  LoadOptions load;
+};
+
+// The seed's traversal compares an error radius with the distance to the point, not a
+// relative bound, so its threshold has its own default.
+constexpr float kLightcutsDefaultError = 0.02f;
+constexpr float kSeedDefaultError = 0.5f;
+
+std::string defaultOutput(const std::string& scene) {
+  std::string stem = scene;
+  size_t slash = stem.find_last_of('/');
+  if (slash != std::string::npos) stem = stem.substr(slash + 1);
+  size_t dot = stem.find_last_of('.');
+  if (dot != std::string::npos && dot > 0) stem = stem.substr(0, dot);
+  return stem + ".png";
+}
+
+nlohmann::json lightCounts(const LightSet& ls) {
+  nlohmann::json j;
+  for (int t = 0; t < kLightTypeCount; ++t) j[lightTypeName(LightType(t))] = ls.countOf(LightType(t));
+  j["total"] = ls.size();
+  return j;
+}
+
+int runRender(RenderArgs& a) {
+  auto t0 = std::chrono::steady_clock::now();
+  if (a.out.empty()) a.out = defaultOutput(a.scene);
+  std::string ext = fileExtension(a.out);
+  if (!io::isWritableImageExtension(ext))
+    throw Error("cannot write '" + a.out + "': unknown image format '." + ext + "' (use .png, .ppm, .bmp or .exr)");
+  // Fail before a long render, not after it.
+  checkWritable(a.out);
+  if (!a.stats.empty()) checkWritable(a.stats);
+  if (!a.cutHeatmap.empty()) checkWritable(a.cutHeatmap);
+  lightcuts::Method method = lightcuts::parseMethod(a.method);
+  lightcuts::TreeBuildOptions tb;
+  tb.builder = a.tree.empty() ? (method == lightcuts::Method::Seed ? lightcuts::TreeBuilder::Seed
+                                                                    : lightcuts::TreeBuilder::Agglomerative)
+                              : lightcuts::parseTreeBuilder(a.tree);
+  tb.seed = a.seed;
+  float error = a.error >= 0 ? a.error : (method == lightcuts::Method::Seed ? kSeedDefaultError : kLightcutsDefaultError);
+  if (!std::isfinite(error)) throw Error("--error must be a finite number >= 0");
+  io::ToneMap tonemap = a.tonemap == "srgb" ? io::ToneMap::Srgb : io::ToneMap::Clamp;
+
+  a.load.threads = a.threads;
+  a.load.quiet = a.quiet;
+  LoadedScene ls = loadScene(a.scene, a.load);
+  scene::Scene& scene = *ls.scene;
+  for (const std::string& w : ls.warnings) fmt::print(stderr, "warning: {}\n", w);
+  if (!ls.objDescription.empty() && !a.quiet)
+    fmt::print(stderr, "OBJ input: added a default camera and lights:\n{}\n", ls.objDescription);
+
+  // Image size: from the flags, completing the missing one from the aspect ratio.
+  const auto& cam = scene.desc().camera;
+  float aspect = cam.aspectRatio ? *cam.aspectRatio : 1.0f;
+  if (a.width <= 0 && a.height <= 0) a.width = 512;
+  if (a.width > 0 && a.height <= 0) a.height = std::max(1, int(std::lround(float(a.width) / aspect)));
+  if (a.height > 0 && a.width <= 0) a.width = std::max(1, int(std::lround(float(a.height) * aspect)));
+  if (uint64_t(a.width) * uint64_t(a.height) > a.load.limits.maxImagePixels)
+    throw Error(fmt::format("an image of {}x{} exceeds --max-image-pixels ({})", a.width, a.height,
+                            a.load.limits.maxImagePixels));
+  scene.setCamera(scene::Camera::fromDesc(cam, float(a.width) / float(a.height)));
+
+  // Light tree and evaluator.
+  lightcuts::LightForest forest;
+  std::unique_ptr<lightcuts::LightEvaluator> evaluator;
+  lightcuts::CutOptions co{error, a.maxCut};
+  if (method == lightcuts::Method::Brute) {
+    evaluator = lightcuts::makeBruteForce(scene.lights());
+  } else {
+    forest = lightcuts::buildLightForest(scene.lights(), tb);
+    evaluator = method == lightcuts::Method::Seed ? lightcuts::makeSeedCuts(scene.lights(), forest, co)
+                                                  : lightcuts::makeLightcuts(scene.lights(), forest, co);
+  }
+
+  render::RenderOptions ro;
+  ro.width = a.width;
+  ro.height = a.height;
+  ro.spp = a.spp;
+  ro.threads = a.threads;
+  ro.maxDepth = a.maxDepth;
+  ro.seed = a.seed;
+  ro.referencePixels = a.referencePixels;
+  ro.cancel = &gInterrupted;
+  ProgressBar bar("rendering", a.quiet);
+  ro.progress = [&](double f) { bar.update(f); };
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  render::RenderResult rr = render::render(scene, *evaluator, ro);
+  bar.finish();
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+
+  if (rr.interrupted) {
+    // Leave the requested output alone; keep what was rendered in OUT.partial.exr.
+    std::string partial = a.out + ".partial.exr";
+    io::writeImage(partial, rr.image);
+    fmt::print(stderr, "lightcuts: interrupted; {} untouched, partial image in {}\n", a.out, partial);
+    return 130;
+  }
+
+  io::writeImage(a.out, rr.image, tonemap);
+  if (!a.cutHeatmap.empty()) {
+    float maxCut = 1;
+    for (float c : rr.cutSize) maxCut = std::max(maxCut, c);
+    io::Image hm = io::heatmap(rr.cutSize, a.width, a.height, 0, maxCut, "lights per pixel (cut size)");
+    io::writeImage(a.cutHeatmap, hm);
+  }
+  double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  const auto& es = rr.stats.eval;
+  double perPoint = es.shadingPoints ? double(es.cutNodes) / double(es.shadingPoints) : 0;
+  double raysPerPoint = es.shadingPoints ? double(es.shadowRays) / double(es.shadingPoints) : 0;
+  uint64_t allRays = rr.stats.primaryRays + rr.stats.secondaryRays + es.shadowRays;
+  const render::ReferenceStats& ref = rr.stats.reference;
+
+  if (!a.stats.empty()) {
+    nlohmann::json j;
+    j["scene"] = a.scene;
+    j["output"] = a.out;
+    j["width"] = a.width;
+    j["height"] = a.height;
+    j["spp"] = a.spp;
+    j["threads"] = a.threads > 0 ? a.threads : int(std::thread::hardware_concurrency());
+    j["method"] = lightcuts::methodName(method);
+    j["error_threshold"] = error;
+    j["max_cut"] = a.maxCut;
+    j["max_depth"] = a.maxDepth;
+    j["time_total_s"] = total;
+    j["time_load_s"] = ls.loadSeconds;
+    j["time_accel_s"] = ls.accelSeconds;
+    j["time_lights_s"] = ls.lightSeconds;
+    j["time_tree_s"] = forest.buildSeconds;
+    j["time_render_s"] = rr.stats.seconds;
+    j["primary_rays"] = rr.stats.primaryRays;
+    j["secondary_rays"] = rr.stats.secondaryRays;
+    j["shadow_rays"] = es.shadowRays;
+    j["rays_per_second"] = rr.stats.seconds > 0 ? double(allRays) / rr.stats.seconds : 0;
+    j["shading_points"] = es.shadingPoints;
+    j["lights"] = lightCounts(scene.lights());
+    j["avg_lights_per_shading_point"] = perPoint;
+    j["avg_shadow_rays_per_shading_point"] = raysPerPoint;
+    j["bounds_evaluated"] = es.boundsEvaluated;
+    nlohmann::json hist = nlohmann::json::array();
+    for (size_t i = 0; i < es.cutHistogram.size(); ++i) {
+      if (!es.cutHistogram[i]) continue;
+      uint64_t lo = i == 0 ? 0 : (uint64_t(1) << (i - 1)), hi = (uint64_t(1) << i) - 1;
+      hist.push_back({{"min", lo}, {"max", hi}, {"count", es.cutHistogram[i]}});
+    }
+    j["cut_histogram"] = hist;
+    if (method != lightcuts::Method::Brute) {
+      j["tree_builder"] = lightcuts::treeBuilderName(tb.builder);
+      j["tree_nodes"] = forest.nodeCount();
+      j["tree_count"] = forest.trees.size();
+      j["tree_memory_bytes"] = forest.memoryBytes();
+    }
+    nlohmann::json objs = nlohmann::json::array();
+    for (const auto& o : ls.objectLights)
+      objs.push_back({{"shape", o.shape}, {"name", o.name}, {"lights", o.lights}, {"area", o.area},
+                      {"power", {o.power.x, o.power.y, o.power.z}}});
+    j["object_lights"] = objs;
+    j["vpls"] = {{"paths", ls.vpls.paths}, {"count", ls.vpls.vpls}, {"time_s", ls.vpls.seconds},
+                 {"clamp_distance", ls.vpls.clampDistance}};
+    if (ref.pixels > 0) {
+      j["reference"] = {{"pixels", ref.pixels},
+                        {"brute_seconds", ref.bruteSeconds},
+                        {"brute_seconds_estimate", ref.bruteSecondsEstimate},
+                        {"test_seconds", ref.testSeconds},
+                        {"speedup_estimate", rr.stats.seconds > 0 ? ref.bruteSecondsEstimate / rr.stats.seconds : 0},
+                        {"mean_relative_error", ref.meanRelativeError},
+                        {"p99_relative_error", ref.p99RelativeError},
+                        {"max_relative_error", ref.maxRelativeError},
+                        {"fraction_over_2pct", ref.fractionOver2pct},
+                        {"brute_lights_per_shading_point", ref.bruteLightsPerShadingPoint}};
+    }
+    std::string text = j.dump(2) + "\n";
+    writeFileAtomically(a.stats, [&](const std::string& tmp) {
+      FILE* f = std::fopen(tmp.c_str(), "wb");
+      if (!f) throw Error("cannot write '" + a.stats + "'");
+      bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+      ok = (std::fclose(f) == 0) && ok;
+      if (!ok) throw Error("cannot write '" + a.stats + "'");
+    });
+  }
+
+  if (!a.quiet) {
+    const LightSet& L = scene.lights();
+    std::string kinds;
+    for (int t = 0; t < kLightTypeCount; ++t)
+      if (size_t c = L.countOf(LightType(t))) kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", c, lightTypeName(LightType(t)));
+    fmt::print("scene      {} ({} objects, {} triangles)\n", a.scene, scene.shapes().size(), scene.triangleCount());
+    fmt::print("lights     {}{}\n", L.size(), kinds.empty() ? "" : " (" + kinds + ")");
+    if (ls.vpls.vpls) fmt::print("vpls       {} from {} paths in {}\n", ls.vpls.vpls, ls.vpls.paths, formatSeconds(ls.vpls.seconds));
+    if (method == lightcuts::Method::Brute)
+      fmt::print("method     brute force\n");
+    else
+      fmt::print("method     {} (tree {}: {} nodes, {:.1f} MiB, built in {}), error {}, max cut {}\n",
+                 lightcuts::methodName(method), lightcuts::treeBuilderName(tb.builder), forest.nodeCount(),
+                 double(forest.memoryBytes()) / (1 << 20), formatSeconds(forest.buildSeconds), error, a.maxCut);
+    fmt::print("image      {}x{}, {} spp -> {}\n", a.width, a.height, a.spp, a.out);
+    fmt::print("time       {} total: load {}, accel {}, lights {}, tree {}, render {}\n", formatSeconds(total),
+               formatSeconds(ls.loadSeconds), formatSeconds(ls.accelSeconds), formatSeconds(ls.lightSeconds),
+               formatSeconds(forest.buildSeconds), formatSeconds(rr.stats.seconds));
+    fmt::print("rays       {} primary, {} secondary, {} shadow ({} rays/s)\n", formatCount(double(rr.stats.primaryRays)),
+               formatCount(double(rr.stats.secondaryRays)), formatCount(double(es.shadowRays)),
+               formatCount(rr.stats.seconds > 0 ? double(allRays) / rr.stats.seconds : 0));
+    fmt::print("per point  {:.1f} lights (cut size), {:.1f} shadow rays, over {} shading points\n", perPoint,
+               raysPerPoint, formatCount(double(es.shadingPoints)));
+    if (ref.pixels > 0) {
+      double speedup = rr.stats.seconds > 0 ? ref.bruteSecondsEstimate / rr.stats.seconds : 0;
+      fmt::print("reference  brute force at {} pixels: {:.1f} lights per point; full image would take ~{} -> speed-up ~{:.1f}x\n",
+                 ref.pixels, ref.bruteLightsPerShadingPoint, formatSeconds(ref.bruteSecondsEstimate), speedup);
+      fmt::print("error      mean {:.2f}%, p99 {:.2f}%, max {:.2f}%, {:.2f}% of sampled pixels over 2%\n",
+                 100 * ref.meanRelativeError, 100 * ref.p99RelativeError, 100 * ref.maxRelativeError,
+                 100 * ref.fractionOver2pct);
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app) {
+  auto a = std::make_shared<RenderArgs>();
+  CLI::App* c = app.add_subcommand("render", "Render a .ray or .obj scene to an image");
+  c->add_option("scene", a->scene, "Scene file (.ray or .obj)")->required();
+  c->add_option("-o,--output", a->out, "Output image: .png .ppm .bmp (8-bit) or .exr (float); default <scene>.png");
+  c->add_option("--width", a->width, "Image width in pixels (default 512; or from --height and the aspect ratio)")
+      ->check(CLI::Range(1, 1 << 16));
+  c->add_option("--height", a->height, "Image height in pixels (default: width / aspect ratio)")->check(CLI::Range(1, 1 << 16));
+  c->add_option("--spp", a->spp, "Samples per pixel, stratified (1 = pixel centre)")->check(CLI::Range(1, 65536));
+  c->add_option("--threads", a->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024));
+  c->add_option("--max-depth", a->maxDepth, "Reflection/refraction recursion depth")->check(CLI::Range(0, 64));
+  c->add_option("--stats", a->stats, "Write statistics as JSON to this file");
+  c->add_flag("-q,--quiet", a->quiet, "No progress bar or summary");
+  c->add_option("--method", a->method, "Direct lighting: lightcuts (Walter et al. 2005), seed (the course project's cuts) or brute")
+      ->check(CLI::IsMember({"lightcuts", "seed", "brute"}));
+  c->add_option("--tree", a->tree, "Light tree: walter (agglomerative) or seed (k-d split); default by method")
+      ->check(CLI::IsMember({"walter", "agglomerative", "seed"}));
+  c->add_option("--error", a->error, "Error threshold: relative bound for lightcuts (default 0.02); radius/distance for seed (default 0.5)")
+      ->check(CLI::Range(0.0, 1e6));
+  c->add_option("--max-cut", a->maxCut, "Most nodes in one cut")->check(CLI::Range(1, 1 << 30));
+  c->add_option("--cut-heatmap", a->cutHeatmap, "Write the per-pixel cut size, colour-mapped with a legend, to this PNG");
+  c->add_option("--reference-pixels", a->referencePixels,
+                "Also run brute force at K pixels: report the measured error and the estimated brute-force time")
+      ->check(CLI::Range(0, 1 << 24));
+  c->add_option("--tonemap", a->tonemap, "8-bit output: clamp (the course renderer's) or srgb")
+      ->check(CLI::IsMember({"clamp", "srgb"}));
+  c->add_option("--seed", a->seed, "Random seed (sampling, representatives, VPLs)");
+  addSceneOptions(*c, a->load);
+  c->callback([a] { exitStatus() = runRender(*a); });
+}
+
+}  // namespace lc::app

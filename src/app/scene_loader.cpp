@@ -1,0 +1,65 @@
+#include "app/scene_loader.h"
+
+#include <chrono>
+
+#include "core/file_util.h"
+#include "io/obj_loader.h"
+#include "io/ray_parser.h"
+
+namespace lc::app {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+}  // namespace
+
+LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
+  LoadedScene out;
+  auto t0 = Clock::now();
+  io::SceneDesc desc;
+  if (fileExtension(path) == "obj") {
+    desc = io::loadObjScene(path, o.limits, &out.objDescription);
+  } else {
+    io::ParseOptions po;
+    po.lenient = o.lenient;
+    po.limits = o.limits;
+    desc = io::parseRayFile(path, po);
+  }
+  out.warnings = desc.warnings;
+  out.loadSeconds = since(t0);
+
+  auto t1 = Clock::now();
+  scene::BuildOptions bo;
+  bo.limits = o.limits;
+  bo.threads = o.threads;
+  out.scene = scene::Scene::build(desc, bo);
+  out.accelSeconds = since(t1);
+
+  auto t2 = Clock::now();
+  out.objectLights = lights::addObjectLights(*out.scene, o.objectLights);
+  if (o.gi) {
+    lights::VplOptions v;
+    const auto& ir = desc.instantRadiosity;
+    if (ir) {
+      if (ir->vpls) v.count = *ir->vpls;
+      if (ir->bounces) v.bounces = *ir->bounces;
+      if (ir->normalize) v.normalize = lights::parseVplNormalize(*ir->normalize);
+      if (ir->clamp) v.clamp = *ir->clamp;
+      if (ir->seed) v.seed = *ir->seed;
+    }
+    if (o.vplCount) v.count = *o.vplCount;
+    if (o.bounces) v.bounces = *o.bounces;
+    if (o.vplNormalize) v.normalize = lights::parseVplNormalize(*o.vplNormalize);
+    if (o.vplClamp) v.clamp = *o.vplClamp;
+    if (o.vplSeed != 1 || !(ir && ir->seed)) v.seed = o.vplSeed;
+    v.maxVpls = o.limits.maxVpls;
+    if (v.count > 0) out.vpls = lights::addVpls(*out.scene, v);
+  }
+  if (out.scene->lights().size() > o.limits.maxLights)
+    throw Error("the scene has " + std::to_string(out.scene->lights().size()) +
+                " lights, more than --max-lights (" + std::to_string(o.limits.maxLights) + ")");
+  out.lightSeconds = since(t2);
+  return out;
+}
+
+}  // namespace lc::app

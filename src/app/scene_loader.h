@@ -1,0 +1,44 @@
+// Loading a scene for the CLI: parse (.ray or .obj), build geometry and materials, then
+// add the generated lights (object lights, VPLs), timing each phase.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/limits.h"
+#include "lights/object_lights.h"
+#include "lights/vpl.h"
+#include "scene/scene.h"
+
+namespace lc::app {
+
+struct LoadOptions {
+  bool lenient = false;
+  Limits limits;
+  int threads = 0;
+  lights::ObjectLightOptions objectLights;
+  // Instant radiosity: command-line values override the scene's instant_radiosity block.
+  std::optional<int> vplCount, bounces;
+  std::optional<std::string> vplNormalize;
+  std::optional<float> vplClamp;
+  uint64_t vplSeed = 1;
+  bool gi = true;             // --gi off ignores instant_radiosity and --vpls
+  bool quiet = false;
+};
+
+struct LoadedScene {
+  std::unique_ptr<scene::Scene> scene;
+  std::vector<lights::ObjectLightInfo> objectLights;
+  lights::VplInfo vpls;
+  std::vector<std::string> warnings;
+  std::string objDescription;  // the default camera/lights added for an OBJ file, in .ray syntax
+  double loadSeconds = 0;      // parsing and textures
+  double accelSeconds = 0;     // Embree BVH
+  double lightSeconds = 0;     // object lights and VPLs
+};
+
+LoadedScene loadScene(const std::string& path, const LoadOptions& options);
+
+}  // namespace lc::app

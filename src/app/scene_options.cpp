@@ -1,0 +1,40 @@
+#include "app/scene_options.h"
+
+namespace lc::app {
+
+void addSceneOptions(CLI::App& c, LoadOptions& o) {
+  c.add_flag("--lenient", o.lenient, "Skip unknown keywords in .ray files with a warning instead of failing");
+  c.add_option("--object-lights", [&o](const CLI::results_t& r) {
+     o.objectLights.kind = lights::parseObjectLightKind(r[0]);
+     return true;
+   }, "Lights of luminous objects: oriented (cosine emission about the surface normal, default) or omni (the seed's)")
+      ->check(CLI::IsMember({"oriented", "omni"}));
+  c.add_option("--object-light-placement", [&o](const CLI::results_t& r) {
+     o.objectLights.placement = lights::parsePlacement(r[0]);
+     return true;
+   }, "Where object lights go: stratified (area-uniform low-discrepancy, default) or seed (the seed's pattern)")
+      ->check(CLI::IsMember({"stratified", "seed"}));
+  c.add_option_function<int>("--vpls", [&o](const int& v) { o.vplCount = v; },
+                             "Instant radiosity: number of light paths shot for virtual point lights (overrides the scene)")
+      ->check(CLI::Range(0, 1 << 30));
+  c.add_option_function<int>("--bounces", [&o](const int& v) { o.bounces = v; }, "Instant radiosity: diffuse bounces (default 1)")
+      ->check(CLI::Range(0, 64));
+  c.add_option_function<std::string>("--vpl-normalize", [&o](const std::string& v) { o.vplNormalize = v; },
+                                     "VPL intensities: power (energy conserving, default) or object (the seed's per-object division)")
+      ->check(CLI::IsMember({"power", "object"}));
+  c.add_option_function<float>("--vpl-clamp", [&o](const float& v) { o.vplClamp = v; },
+                               "VPL distance clamp, as a fraction of half the scene diagonal (default 0.05)")
+      ->check(CLI::Range(0.0f, 1e6f));
+  c.add_option_function<std::string>("--gi", [&o](const std::string& v) { o.gi = v == "on"; },
+                                     "Global illumination from VPLs: on (default) or off")
+      ->check(CLI::IsMember({"on", "off"}));
+  c.add_option("--max-lights", o.limits.maxLights, "Limit on lights (object lights, VPLs and scene lights)");
+  c.add_option("--max-vpls", o.limits.maxVpls, "Limit on VPLs");
+  c.add_option_function<uint64_t>("--max-triangles", [&o](const uint64_t& v) { o.limits.maxTriangles = o.limits.maxVertices = v; },
+                                  "Limit on triangles (and vertices) in all meshes");
+  c.add_option("--max-nesting", o.limits.maxNesting, "Limit on nested transforms and groups in .ray files");
+  c.add_option("--max-image-pixels", o.limits.maxImagePixels, "Limit on width x height");
+  c.add_option("--max-texture-pixels", o.limits.maxTexturePixels, "Limit on the pixels of one texture");
+}
+
+}  // namespace lc::app

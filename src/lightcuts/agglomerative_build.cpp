@@ -1,0 +1,583 @@
+// Agglomerative light-tree construction (Walter et al. 2005), made O(N log N) in practice
+// with the heap-based nearest-neighbour clustering of Walter et al. 2008 ("Fast
+// agglomerative clustering for rendering"):
+//   - every cluster finds its best partner under the merge metric with a branch-and-bound
+//     search in a k-d tree over cluster centres; the k-d nodes carry conservative
+//     aggregates (union of boxes, cone of axes, minimum intensity) that give a lower bound
+//     of the metric for anything below them;
+//   - a min-heap holds (metric, A, best partner of A); popping a pair whose clusters are
+//     both alive merges them, the merged cluster takes A's k-d slot and finds its own
+//     best partner; stale pairs (partner already merged) are re-queried lazily;
+//   - aggregates only ever grow, so they stay sound; the k-d tree is rebuilt over the
+//     live clusters each time their number halves, which keeps the bounds tight.
+// Up to kExactLimit lights the whole tree is built that way: the exact greedy clustering.
+// Larger sets would spend most of the time in those searches at the bottom of the tree,
+// where every decision is local anyway, so there the lights are ordered along a Morton
+// curve and clustered bottom-up in small groups first (approximate agglomerative
+// clustering, Gu et al. 2013: each group of n keeps f(n) = c n^0.4 clusters, merged
+// greedily with the same metric by brute-force nearest neighbours); the few thousand
+// clusters left are then clustered exactly as above, so the top of the tree, where the
+// cut spends its time, is the greedy one. Every merge takes its id from a block fixed in
+// advance, so the tree never depends on thread timing.
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#include <tbb/task_group.h>
+
+#include <algorithm>
+#include <cmath>
+#include <array>
+#include <queue>
+
+#include "lightcuts/cluster.h"
+
+namespace lc::lightcuts {
+
+namespace {
+
+using detail::Cluster;
+
+constexpr int kLeafSize = 4;
+
+// A cluster as the k-d leaves hold it: compact and contiguous, so a leaf scan touches one
+// or two cache lines instead of chasing ids into the cluster array.
+struct Slot {
+  Vec3 lo, hi;
+  Vec3 axis;
+  float weight;
+  float halfAngle;
+  int32_t id;  // local cluster index, -1 when the slot is empty
+};
+
+struct KdNode {
+  Vec3 ulo, uhi;           // union of the boxes of the clusters below
+  Vec3 coneAxis{0, 0, 1};  // cone containing the axes of the clusters below
+  float coneCos = 1, coneAngle = 0;
+  float minWeight = 0;     // lower bound of their weights (weights only grow)
+  int32_t alive = 0;
+  int32_t child = -1;      // inner node: children at child, child + 1
+  int32_t slotBegin = 0, slotEnd = 0;  // leaf: range in `slots_`
+  int32_t parent = -1;
+};
+
+struct Pair {
+  float d;
+  int32_t a, b;
+  bool operator>(const Pair& o) const {
+    if (d != o.d) return d > o.d;
+    if (a != o.a) return a > o.a;
+    return b > o.b;
+  }
+};
+
+// The merge metric is only a heuristic for which clusters to merge (the cones stored in
+// the tree come from the exact coneUnion), so it uses cheap monotone approximations:
+// acos after Abramowitz & Stegun 4.4.45 (error < 7e-5 rad) and 1 - cos t = 2 sin^2(t/2)
+// with a 7th-order sine.
+inline float fastAcos(float x) {
+  x = std::clamp(x, -1.0f, 1.0f);
+  float ax = std::fabs(x);
+  float r = std::sqrt(1 - ax) * (1.5707288f + ax * (-0.2121144f + ax * (0.0742610f - 0.0187293f * ax)));
+  return x >= 0 ? r : kPi - r;
+}
+inline float oneMinusCos(float t) {
+  float u = 0.5f * std::clamp(t, 0.0f, kPi), u2 = u * u;
+  float s = u * (1 - u2 * (1.0f / 6 - u2 * (1.0f / 120 - u2 * (1.0f / 5040))));
+  return 2 * s * s;
+}
+
+// Half-angle of the union of two cones, consistent with coneUnion().
+inline float unionHalfAngle(float ta, float tb, float td) {
+  if (std::min(td + tb, kPi) <= ta) return ta;
+  if (std::min(td + ta, kPi) <= tb) return tb;
+  return std::min(kPi, 0.5f * (ta + td + tb));
+}
+
+// Greedy clustering of a set of clusters down to `target` survivors. Works on a local,
+// compact copy of its input (cache-friendly); merged clusters get ids idBase, idBase+1, ...
+class AgglomerativeBuilder {
+ public:
+  AgglomerativeBuilder(bool withCone, float coneWeight, uint64_t seed)
+      : withCone_(withCone), c_(coneWeight), c2_(coneWeight * coneWeight), seed_(seed) {}
+
+  // Clusters `ids` (indices into `all`) until `target` remain. Appends the merged clusters,
+  // with children as global ids, to `created` and returns the global ids of the survivors.
+  std::vector<int32_t> reduce(const std::vector<Cluster>& all, const std::vector<int32_t>& ids,
+                              size_t target, int32_t idBase, std::vector<Cluster>& created,
+                              bool parallelQueries) {
+    size_t n = ids.size();
+    if (n <= std::max<size_t>(target, 1)) return ids;
+    cl_.clear();
+    cl_.reserve(2 * n);
+    global_.clear();
+    global_.reserve(2 * n);
+    for (int32_t g : ids) {
+      cl_.push_back(all[size_t(g)]);
+      global_.push_back(g);
+    }
+    slotOf_.assign(2 * n, -1);
+    dead_.assign(2 * n, 0);
+    std::vector<int32_t> local(n);
+    for (size_t i = 0; i < n; ++i) local[i] = int32_t(i);
+    buildKd(local);
+
+    std::vector<Pair> initial(n);
+    auto query = [&](size_t i) {
+      auto [d, b] = best(int32_t(i));
+      initial[i] = Pair{d, int32_t(i), b};
+    };
+    if (parallelQueries)
+      tbb::parallel_for(size_t(0), n, query);
+    else
+      for (size_t i = 0; i < n; ++i) query(i);
+    std::priority_queue<Pair, std::vector<Pair>, std::greater<Pair>> heap(std::greater<Pair>(),
+                                                                          std::move(initial));
+    size_t alive = n;
+    while (alive > target && !heap.empty()) {
+      Pair p = heap.top();
+      heap.pop();
+      if (dead_[size_t(p.a)]) continue;
+      if (p.b < 0 || dead_[size_t(p.b)]) {
+        auto [d, b] = best(p.a);
+        heap.push(Pair{d, p.a, b});
+        continue;
+      }
+      int32_t c = int32_t(cl_.size());
+      int32_t ga = global_[size_t(p.a)], gb = global_[size_t(p.b)];
+      cl_.push_back(detail::mergeClusters(cl_[size_t(p.a)], cl_[size_t(p.b)], ga, gb, withCone_, seed_));
+      global_.push_back(idBase + int32_t(created.size()));
+      created.push_back(cl_.back());
+      dead_[size_t(p.a)] = dead_[size_t(p.b)] = 1;
+      --alive;
+      replace(p.a, p.b, c);
+      if (alive <= target) break;
+      if (alive * 2 < aliveAtBuild_ && alive > 64) {
+        std::vector<int32_t> live;
+        live.reserve(alive);
+        for (const Slot& s : slots_)
+          if (s.id >= 0) live.push_back(s.id);
+        buildKd(live);
+      }
+      auto [d, b] = best(c);
+      heap.push(Pair{d, c, b});
+    }
+    std::vector<int32_t> survivors;
+    for (size_t i = 0; i < cl_.size(); ++i)
+      if (!dead_[i]) survivors.push_back(global_[i]);
+    return survivors;
+  }
+
+ private:
+  static Slot slotOfCluster(const Cluster& c, int32_t id) {
+    return Slot{c.lo, c.hi, c.axis, c.weight, c.halfAngle, id};
+  }
+
+  // Merge metric of cluster a with slot x; `cutoff` lets it stop before the trigonometry
+  // once the positional part alone is already worse.
+  __attribute__((always_inline)) float pairMetric(const Slot& a, const Slot& x, float cutoff) const {
+    Vec3 e = vmax(a.hi, x.hi) - vmin(a.lo, x.lo);
+    float w = a.weight + x.weight;
+    float m = w * dot(e, e);
+    if (!withCone_ || m > cutoff) return m;
+    float oc = oneMinusCos(unionHalfAngle(a.halfAngle, x.halfAngle, fastAcos(dot(a.axis, x.axis))));
+    return m + w * c2_ * oc * oc;
+  }
+
+  // Lower bound of pairMetric(a, x) for every cluster x below k-d node n: x's box lies in
+  // the union box and x's axis in the node's cone, and the merged cone's half-angle is at
+  // least a's and at least half the angle between the axes.
+  __attribute__((always_inline)) float lowerBound(const Slot& a, const KdNode& n, float cutoff) const {
+    // Per axis: a's extent plus the gap to the union box (at most one side is positive).
+    Vec3 ext = (a.hi - a.lo) + vmax(n.ulo - a.hi, Vec3(0)) + vmax(a.lo - n.uhi, Vec3(0));
+    float m = dot(ext, ext);
+    float w = a.weight + n.minWeight;
+    m *= w;
+    if (!withCone_ || m > cutoff) return m;
+    float td = fastAcos(dot(a.axis, n.coneAxis)) - n.coneAngle;
+    float oc = oneMinusCos(std::max(a.halfAngle, 0.5f * std::max(0.0f, td)));
+    return m + w * c2_ * oc * oc;
+  }
+
+  std::pair<float, int32_t> best(int32_t ai) const {
+    const Slot a = slotOfCluster(cl_[size_t(ai)], ai);
+    float bestD = kInf;
+    int32_t bestId = -1;
+    auto scanLeaf = [&](const KdNode& n) {
+      for (int32_t s = n.slotBegin; s < n.slotEnd; ++s) {
+        const Slot& x = slots_[size_t(s)];
+        if (x.id < 0 || x.id == ai) continue;
+        float d = pairMetric(a, x, bestD);
+        if (d < bestD || (d == bestD && x.id < bestId)) {
+          bestD = d;
+          bestId = x.id;
+        }
+      }
+    };
+    // a's own leaf first: a close candidate early makes the bound prune most of the tree.
+    int32_t home = slotOf_[size_t(ai)] >= 0 ? leafOfSlot_[size_t(slotOf_[size_t(ai)])] : -1;
+    if (home >= 0) scanLeaf(kd_[size_t(home)]);
+    struct Item {
+      int32_t node;
+      float lb;
+    };
+    Item stack[128];
+    int sp = 0;
+    stack[sp++] = Item{0, 0.0f};
+    while (sp > 0) {
+      Item it = stack[--sp];
+      if (it.lb > bestD) continue;
+      const KdNode& n = kd_[size_t(it.node)];
+      if (n.child < 0) {
+        if (it.node != home) scanLeaf(n);
+        continue;
+      }
+      const KdNode& l = kd_[size_t(n.child)];
+      const KdNode& r = kd_[size_t(n.child + 1)];
+      float lbL = l.alive ? lowerBound(a, l, bestD) : kInf;
+      float lbR = r.alive ? lowerBound(a, r, bestD) : kInf;
+      // Push the farther child first so the nearer one is searched first.
+      if (lbL <= lbR) {
+        if (lbR <= bestD && sp < 128) stack[sp++] = Item{n.child + 1, lbR};
+        if (lbL <= bestD && sp < 128) stack[sp++] = Item{n.child, lbL};
+      } else {
+        if (lbL <= bestD && sp < 128) stack[sp++] = Item{n.child, lbL};
+        if (lbR <= bestD && sp < 128) stack[sp++] = Item{n.child + 1, lbR};
+      }
+    }
+    return {bestD, bestId};
+  }
+
+  // A k-d tree over cluster centres; with cones, over (centre, c * axis) in 6-D so that
+  // clusters of different orientation separate as well as distant ones.
+  void buildKd(const std::vector<int32_t>& ids) {
+    kd_.clear();
+    slots_.resize(ids.size());
+    leafOfSlot_.assign(ids.size(), -1);
+    aliveAtBuild_ = ids.size();
+    const int dims = withCone_ ? 6 : 3;
+    std::vector<std::array<float, 6>> key(ids.size());
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const Cluster& c = cl_[size_t(ids[i])];
+      Vec3 p = (c.lo + c.hi) * 0.5f;
+      key[i] = {p.x, p.y, p.z, c_ * c.axis.x, c_ * c.axis.y, c_ * c.axis.z};
+    }
+    std::vector<int32_t> order(ids.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = int32_t(i);
+
+    struct Task {
+      int32_t node, begin, end;
+    };
+    std::vector<Task> tasks;
+    kd_.push_back(KdNode{});
+    tasks.push_back(Task{0, 0, int32_t(ids.size())});
+    while (!tasks.empty()) {
+      Task t = tasks.back();
+      tasks.pop_back();
+      if (t.end - t.begin <= kLeafSize) {
+        kd_[size_t(t.node)].slotBegin = t.begin;
+        kd_[size_t(t.node)].slotEnd = t.end;
+        continue;
+      }
+      float lo[6], hi[6];
+      for (int k = 0; k < dims; ++k) lo[k] = kInf, hi[k] = -kInf;
+      for (int32_t i = t.begin; i < t.end; ++i)
+        for (int k = 0; k < dims; ++k) {
+          float v = key[size_t(order[size_t(i)])][size_t(k)];
+          lo[k] = std::min(lo[k], v);
+          hi[k] = std::max(hi[k], v);
+        }
+      int axis = 0;
+      for (int k = 1; k < dims; ++k)
+        if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+      int32_t mid = (t.begin + t.end) / 2;
+      std::nth_element(order.begin() + t.begin, order.begin() + mid, order.begin() + t.end,
+                       [&](int32_t p, int32_t q) {
+                         float cp = key[size_t(p)][size_t(axis)], cq = key[size_t(q)][size_t(axis)];
+                         return cp < cq || (cp == cq && p < q);
+                       });
+      int32_t c = int32_t(kd_.size());
+      kd_[size_t(t.node)].child = c;
+      kd_.push_back(KdNode{});
+      kd_.push_back(KdNode{});
+      kd_[size_t(c)].parent = kd_[size_t(c + 1)].parent = t.node;
+      tasks.push_back(Task{c + 1, mid, t.end});
+      tasks.push_back(Task{c, t.begin, mid});
+    }
+    for (size_t i = 0; i < order.size(); ++i) {
+      int32_t id = ids[size_t(order[i])];
+      slots_[i] = slotOfCluster(cl_[size_t(id)], id);
+      slotOf_[size_t(id)] = int32_t(i);
+    }
+    // Aggregates bottom-up: children are created after their parent.
+    for (size_t k = kd_.size(); k-- > 0;) {
+      KdNode& n = kd_[k];
+      if (n.child < 0) {
+        n.ulo = Vec3(kInf);
+        n.uhi = Vec3(-kInf);
+        n.minWeight = kInf;
+        for (int32_t s = n.slotBegin; s < n.slotEnd; ++s) {
+          leafOfSlot_[size_t(s)] = int32_t(k);
+          const Slot& c = slots_[size_t(s)];
+          n.ulo = vmin(n.ulo, c.lo);
+          n.uhi = vmax(n.uhi, c.hi);
+          n.minWeight = std::min(n.minWeight, c.weight);
+          if (withCone_) {
+            if (s == n.slotBegin) {
+              n.coneAxis = c.axis;
+              n.coneCos = 1;
+            } else {
+              coneUnion(n.coneAxis, n.coneCos, c.axis, 1.0f, n.coneAxis, n.coneCos);
+            }
+          }
+        }
+        n.alive = n.slotEnd - n.slotBegin;
+      } else {
+        const KdNode& l = kd_[size_t(n.child)];
+        const KdNode& r = kd_[size_t(n.child + 1)];
+        n.ulo = vmin(l.ulo, r.ulo);
+        n.uhi = vmax(l.uhi, r.uhi);
+        n.minWeight = std::min(l.minWeight, r.minWeight);
+        n.alive = l.alive + r.alive;
+        if (withCone_) coneUnion(l.coneAxis, l.coneCos, r.coneAxis, r.coneCos, n.coneAxis, n.coneCos);
+      }
+      n.coneAngle = std::acos(std::clamp(n.coneCos, -1.0f, 1.0f));
+    }
+  }
+
+  // Cluster c (= a + b) takes a's slot; b's slot empties.
+  void replace(int32_t a, int32_t b, int32_t c) {
+    int32_t sa = slotOf_[size_t(a)], sb = slotOf_[size_t(b)];
+    const Cluster& cc = cl_[size_t(c)];
+    slots_[size_t(sa)] = slotOfCluster(cc, c);
+    slotOf_[size_t(c)] = sa;
+    slotOf_[size_t(a)] = -1;
+    for (int32_t k = leafOfSlot_[size_t(sa)]; k >= 0; k = kd_[size_t(k)].parent) {
+      KdNode& n = kd_[size_t(k)];
+      bool boxInside = cc.lo.x >= n.ulo.x && cc.lo.y >= n.ulo.y && cc.lo.z >= n.ulo.z &&
+                       cc.hi.x <= n.uhi.x && cc.hi.y <= n.uhi.y && cc.hi.z <= n.uhi.z;
+      bool axisInside = !withCone_ || dot(cc.axis, n.coneAxis) >= n.coneCos;
+      if (boxInside && axisInside) break;  // ancestors contain this node: nothing changes above
+      n.ulo = vmin(n.ulo, cc.lo);
+      n.uhi = vmax(n.uhi, cc.hi);
+      if (!axisInside) {
+        coneUnion(n.coneAxis, n.coneCos, cc.axis, 1.0f, n.coneAxis, n.coneCos);
+        n.coneAngle = std::acos(std::clamp(n.coneCos, -1.0f, 1.0f));
+      }
+    }
+    slots_[size_t(sb)].id = -1;
+    slotOf_[size_t(b)] = -1;
+    for (int32_t k = leafOfSlot_[size_t(sb)]; k >= 0; k = kd_[size_t(k)].parent) --kd_[size_t(k)].alive;
+  }
+
+  std::vector<Cluster> cl_;        // local clusters: inputs first, then merges
+  std::vector<int32_t> global_;    // global id of each local cluster
+  bool withCone_;
+  float c_, c2_;
+  uint64_t seed_;
+  std::vector<KdNode> kd_;
+  std::vector<Slot> slots_;
+  std::vector<int32_t> slotOf_;      // slot of each local cluster, -1 when not in the k-d tree
+  std::vector<int32_t> leafOfSlot_;  // k-d leaf holding each slot
+  std::vector<uint8_t> dead_;
+  size_t aliveAtBuild_ = 0;
+};
+
+}  // namespace
+
+namespace {
+
+// 10 bits per axis of Morton order within `b`.
+uint32_t mortonCode(const Vec3& p, const Bounds3& b) {
+  auto spread = [](uint32_t x) {
+    x = (x | (x << 16)) & 0x030000FFu;
+    x = (x | (x << 8)) & 0x0300F00Fu;
+    x = (x | (x << 4)) & 0x030C30C3u;
+    x = (x | (x << 2)) & 0x09249249u;
+    return x;
+  };
+  Vec3 e = b.extent();
+  uint32_t q[3];
+  for (int i = 0; i < 3; ++i) {
+    float t = e[i] > 0 ? (p[i] - b.lo[i]) / e[i] : 0.5f;
+    q[i] = uint32_t(std::clamp(t * 1023.0f, 0.0f, 1023.0f));
+  }
+  return (spread(q[0]) << 2) | (spread(q[1]) << 1) | spread(q[2]);
+}
+
+// The bottom-up stage for large light sets (AAC-HQ parameters of Gu et al. 2013).
+class ApproximateClustering {
+ public:
+  static constexpr size_t kGroup = 20;  // delta: lights per bottom group
+  static constexpr double kAlpha = 0.4;
+
+  ApproximateClustering(std::vector<Cluster>& all, bool withCone, float coneWeight, uint64_t seed)
+      : all_(all), withCone_(withCone), c2_(coneWeight * coneWeight), seed_(seed) {}
+
+  // Clusters kept by a group of n: f(n) = c n^alpha with f(delta) = delta / 2.
+  static size_t keep(size_t n) {
+    double c = std::pow(double(kGroup), 1 - kAlpha) / 2;
+    return std::max<size_t>(1, size_t(std::ceil(c * std::pow(double(n), kAlpha))));
+  }
+  // How many clusters the recursion over n lights returns (depends on n alone).
+  static size_t survivors(size_t n) {
+    if (n <= kGroup) return std::min(n, keep(n));
+    size_t h = n / 2;
+    return std::min(survivors(h) + survivors(n - h), keep(n));
+  }
+
+  // Clusters the leaves order[b, e) (Morton order); merged clusters take ids from
+  // idBase on. Returns the surviving cluster ids.
+  std::vector<int32_t> run(const std::vector<int32_t>& order, size_t b, size_t e, int32_t idBase) {
+    size_t n = e - b;
+    std::vector<int32_t> set;
+    if (n <= kGroup) {
+      set.assign(order.begin() + long(b), order.begin() + long(e));
+    } else {
+      size_t h = n / 2;
+      std::vector<int32_t> left, right;
+      int32_t rightBase = idBase + int32_t(h - survivors(h));
+      if (n > 4096) {
+        tbb::task_group g;
+        g.run([&] { left = run(order, b, b + h, idBase); });
+        right = run(order, b + h, e, rightBase);
+        g.wait();
+      } else {
+        left = run(order, b, b + h, idBase);
+        right = run(order, b + h, e, rightBase);
+      }
+      set = std::move(left);
+      set.insert(set.end(), right.begin(), right.end());
+      idBase = rightBase + int32_t((n - h) - survivors(n - h));
+    }
+    combine(set, keep(n), idBase);
+    return set;
+  }
+
+ private:
+  float metric(const Cluster& a, const Cluster& x) const {
+    Vec3 e = vmax(a.hi, x.hi) - vmin(a.lo, x.lo);
+    float m = dot(e, e);
+    if (withCone_) {
+      float oc = oneMinusCos(unionHalfAngle(a.halfAngle, x.halfAngle, fastAcos(dot(a.axis, x.axis))));
+      m += c2_ * oc * oc;
+    }
+    return (a.weight + x.weight) * m;
+  }
+
+  // Greedy merging inside a small set, nearest neighbours by brute force.
+  void combine(std::vector<int32_t>& set, size_t target, int32_t idBase) {
+    size_t m = set.size();
+    if (m <= target) return;
+    std::vector<float> nnD(m, kInf);
+    std::vector<int32_t> nn(m, -1);
+    auto refresh = [&](size_t i) {
+      nnD[i] = kInf;
+      nn[i] = -1;
+      for (size_t j = 0; j < m; ++j) {
+        if (j == i) continue;
+        float d = metric(all_[size_t(set[i])], all_[size_t(set[j])]);
+        if (d < nnD[i]) {
+          nnD[i] = d;
+          nn[i] = int32_t(j);
+        }
+      }
+    };
+    for (size_t i = 0; i < m; ++i) refresh(i);
+    int32_t next = idBase;
+    while (m > target) {
+      size_t i = 0;
+      for (size_t k = 1; k < m; ++k)
+        if (nnD[k] < nnD[i]) i = k;
+      size_t j = size_t(nn[i]);
+      int32_t id = next++;
+      all_[size_t(id)] = detail::mergeClusters(all_[size_t(set[i])], all_[size_t(set[j])], set[i], set[j],
+                                               withCone_, seed_);
+      // The merged cluster takes i's place; the last one moves into j's.
+      set[i] = id;
+      size_t last = m - 1;
+      set[j] = set[last];
+      nnD[j] = nnD[last];
+      nn[j] = nn[last];
+      --m;
+      set.resize(m);
+      for (size_t k = 0; k < m; ++k)
+        if (nn[k] == int32_t(last)) nn[k] = int32_t(j);
+      if (i == last) i = j;
+      refresh(i);
+      for (size_t k = 0; k < m; ++k) {
+        if (k == i) continue;
+        if (nn[k] == int32_t(i) || nn[k] == int32_t(j) || nn[k] < 0) {
+          refresh(k);
+        } else {
+          float d = metric(all_[size_t(set[k])], all_[size_t(set[i])]);
+          if (d < nnD[k]) {
+            nnD[k] = d;
+            nn[k] = int32_t(i);
+          }
+        }
+      }
+    }
+  }
+
+  std::vector<Cluster>& all_;
+  bool withCone_;
+  float c2_;
+  uint64_t seed_;
+};
+
+}  // namespace
+
+LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint32_t>& indices,
+                                 LightType type, float coneWeight, uint64_t seed, size_t exactLimit) {
+  LightTree tree;
+  tree.type = type;
+  if (indices.empty()) return tree;
+  size_t n = indices.size();
+  bool withCone = (type == LightType::Oriented || type == LightType::Spot) && coneWeight > 0;
+  // Ids: leaves 0..n-1, merges n..2n-2, handed out in fixed blocks.
+  std::vector<Cluster> clusters(2 * n - 1);
+  for (size_t i = 0; i < n; ++i) clusters[i] = detail::leafCluster(lights.lights[indices[i]], indices[i]);
+  if (n == 1) {
+    detail::layoutTree(clusters, 0, tree);
+    return tree;
+  }
+
+  std::vector<int32_t> top;
+  int32_t nextId = int32_t(n);
+  if (n <= exactLimit) {
+    for (size_t i = 0; i < n; ++i) top.push_back(int32_t(i));
+  } else {
+    Bounds3 b;
+    for (size_t i = 0; i < n; ++i) b.extend(clusters[i].lo);
+    std::vector<std::pair<uint32_t, int32_t>> keyed(n);
+    tbb::parallel_for(size_t(0), n, [&](size_t i) { keyed[i] = {mortonCode(clusters[i].lo, b), int32_t(i)}; });
+    tbb::parallel_sort(keyed.begin(), keyed.end());
+    std::vector<int32_t> order(n);
+    for (size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
+    // Bottom-up in chunks, each reduced to its survivors; chunks are as large as it takes
+    // to leave at most half of exactLimit clusters for the exact top levels.
+    size_t chunk = exactLimit;
+    while ((n + chunk - 1) / chunk * ApproximateClustering::survivors(chunk) > exactLimit / 2) chunk *= 2;
+    size_t chunks = (n + chunk - 1) / chunk;
+    std::vector<std::vector<int32_t>> survivors(chunks);
+    std::vector<int32_t> idBase(chunks);
+    for (size_t c = 0; c < chunks; ++c) {
+      size_t size = std::min(chunk, n - c * chunk);
+      idBase[c] = nextId;
+      nextId += int32_t(size - ApproximateClustering::survivors(size));
+    }
+    tbb::parallel_for(size_t(0), chunks, [&](size_t c) {
+      size_t begin = c * chunk, end = std::min(n, begin + chunk);
+      ApproximateClustering aac(clusters, withCone, coneWeight, seed);
+      survivors[c] = aac.run(order, begin, end, idBase[c]);
+    });
+    for (const auto& s : survivors) top.insert(top.end(), s.begin(), s.end());
+  }
+  std::vector<Cluster> created;
+  AgglomerativeBuilder builder(withCone, coneWeight, seed);
+  std::vector<int32_t> root = builder.reduce(clusters, top, 1, nextId, created, true);
+  std::copy(created.begin(), created.end(), clusters.begin() + nextId);
+  detail::layoutTree(clusters, root[0], tree);
+  return tree;
+}
+
+}  // namespace lc::lightcuts

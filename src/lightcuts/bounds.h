@@ -1,0 +1,89 @@
+// Upper bounds of a light cluster's unshadowed contribution (Walter et al. 2005, sec. 4.1):
+//   bound = M_ub * G_ub * I_C  (visibility bounded by 1)
+// Every factor is a true upper bound over all lights the cluster may hold: the property
+// tests in bounds_test.cpp check that against brute force on random configurations.
+#pragma once
+
+#include <cmath>
+
+#include "core/math.h"
+#include "lightcuts/light_tree.h"
+#include "lightcuts/shading.h"
+
+namespace lc::lightcuts {
+
+// An orthonormal frame whose w axis is the direction of interest.
+struct Frame {
+  Vec3 u, v, w;
+};
+inline Frame makeFrame(const Vec3& w) {
+  Frame f;
+  f.w = w;
+  orthonormalBasis(w, f.u, f.v);
+  return f;
+}
+
+// Upper bound of cos(angle(f.w, q)) over all vectors q in the box [lo, hi] (a box of
+// vectors from the origin). The box is rotated into the frame and re-bounded (centre
+// and |R| times the half extent); then with z the axis: cos <= Mz / sqrt(min x^2 +
+// min y^2 + Mz^2), and <= 0 when Mz <= 0 (returned as 0).
+inline float cosBoundBox(const Frame& f, const Vec3& lo, const Vec3& hi) {
+  Vec3 c = (lo + hi) * 0.5f, h = (hi - lo) * 0.5f;
+  float mz = dot(c, f.w) + dot(vabs(f.w), h);
+  if (mz <= 0) return 0;
+  float cx = dot(c, f.u), hx = dot(vabs(f.u), h);
+  float cy = dot(c, f.v), hy = dot(vabs(f.v), h);
+  float ax = std::fabs(cx) - hx, ay = std::fabs(cy) - hy;  // distance of the x/y ranges from 0
+  float x2 = ax > 0 ? ax * ax : 0, y2 = ay > 0 ? ay * ay : 0;
+  return std::min(1.0f, mz / std::sqrt(x2 + y2 + mz * mz));
+}
+
+// Widens a cosine bound by a cone of half-angle beta: directions within beta of the axis
+// can be up to beta closer to the target. cos(theta - beta) when theta > beta, else 1.
+inline float coneWiden(float cosTheta, float cosBeta) {
+  if (cosBeta <= -1.0f || cosTheta >= cosBeta) return 1.0f;
+  float sinTheta = std::sqrt(std::max(0.0f, 1 - cosTheta * cosTheta));
+  float sinBeta = std::sqrt(std::max(0.0f, 1 - cosBeta * cosBeta));
+  return std::min(1.0f, cosTheta * cosBeta + sinTheta * sinBeta);
+}
+
+// Frames of a shading point that every cluster bound reuses.
+struct BoundFrames {
+  Frame n, r;
+  explicit BoundFrames(const ShadingPoint& sp) : n(makeFrame(sp.n)), r(makeFrame(sp.r)) {}
+};
+
+// Upper bound (RGB) of the sum of the unshadowed contributions of the node's lights.
+inline Color clusterBound(const LightNode& node, LightType type, const LightGroup& g,
+                          const ShadingPoint& sp, const BoundFrames& fr) {
+  Vec3 lo, hi;  // vectors from the shading point toward the cluster's lights
+  if (type == LightType::Directional) {
+    lo = node.lo;
+    hi = node.hi;
+  } else {
+    lo = node.lo - sp.p;
+    hi = node.hi - sp.p;
+  }
+  // Cosine bounds get a little slack so float rounding in the exact evaluation can never
+  // exceed them (steep spot falloffs and high Phong exponents amplify it).
+  constexpr float kSlack = 2e-5f;
+  float cN = cosBoundBox(fr.n, lo, hi);
+  if (cN <= 0) return Color(0);  // every light is behind the surface
+  Color m = sp.kd * std::min(1.0f, cN + kSlack);
+  if (!g.diffuseOnly && sp.hasSpecular())
+    m += sp.ks * std::pow(std::min(1.0f, cosBoundBox(fr.r, lo, hi) + kSlack), sp.shininess);
+  float G = 1;
+  if (type != LightType::Directional) {
+    Bounds3 box(node.lo, node.hi);
+    G = g.atten(std::sqrt(box.distance2(sp.p)));
+    if (type == LightType::Oriented || type == LightType::Spot) {
+      // Directions from the lights to the point lie in the box [-hi, -lo].
+      float cL = std::min(1.0f, coneWiden(cosBoundBox(makeFrame(node.axis), -hi, -lo), node.cosHalfAngle) + kSlack);
+      G *= type == LightType::Oriented ? std::max(0.0f, cL) : g.falloff(cL);
+    }
+  }
+  // A little slack so float rounding never puts the bound below an exact value.
+  return m * (G * 1.0001f) * node.intensity;
+}
+
+}  // namespace lc::lightcuts

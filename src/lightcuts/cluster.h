@@ -1,0 +1,101 @@
+// Internal to the tree builders: clusters as they are formed, merged and finally laid out
+// as LightNodes (children adjacent, parents before children).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/rng.h"
+#include "lightcuts/light_tree.h"
+
+namespace lc::lightcuts::detail {
+
+struct Cluster {
+  Vec3 lo, hi;
+  Vec3 axis;
+  float cosHalfAngle = 1;
+  float halfAngle = 0;  // acos(cosHalfAngle), cached for the metric
+  float weight = 0;     // luminance of the summed intensity: the metric's I
+  Color intensity;
+  uint32_t rep = 0;
+  int32_t left = -1, right = -1;
+  uint32_t count = 1;
+};
+
+// Position a light occupies in its tree: directional lights cluster by the direction
+// toward them.
+inline Vec3 clusterPoint(const Light& l) {
+  return l.type == LightType::Directional ? -l.direction : l.position;
+}
+
+inline Cluster leafCluster(const Light& l, uint32_t index) {
+  Cluster c;
+  c.lo = c.hi = clusterPoint(l);
+  bool hasCone = l.type == LightType::Oriented || l.type == LightType::Spot;
+  c.axis = hasCone ? l.direction : Vec3(0, 0, 1);
+  c.cosHalfAngle = hasCone ? 1.0f : -1.0f;
+  c.halfAngle = hasCone ? 0.0f : kPi;
+  c.intensity = l.intensity;
+  c.weight = luminance(l.intensity);
+  c.rep = index;
+  return c;
+}
+
+// Union of two clusters. The representative is one of the children's, chosen with
+// probability proportional to intensity from a hash of (seed, children): deterministic
+// whatever the thread count.
+inline Cluster mergeClusters(const Cluster& a, const Cluster& b, int32_t ia, int32_t ib,
+                             bool withCone, uint64_t seed) {
+  Cluster c;
+  c.lo = vmin(a.lo, b.lo);
+  c.hi = vmax(a.hi, b.hi);
+  if (withCone) {
+    coneUnion(a.axis, a.cosHalfAngle, b.axis, b.cosHalfAngle, c.axis, c.cosHalfAngle);
+    c.halfAngle = std::acos(std::clamp(c.cosHalfAngle, -1.0f, 1.0f));
+  } else {
+    c.axis = a.axis;
+    c.cosHalfAngle = -1;
+    c.halfAngle = kPi;
+  }
+  c.intensity = a.intensity + b.intensity;
+  c.weight = a.weight + b.weight;
+  uint64_t h = splitmix64(seed ^ (uint64_t(uint32_t(ia)) << 32 | uint32_t(ib)));
+  double u = double(h >> 11) * 0x1p-53;
+  c.rep = (c.weight > 0 ? u * c.weight < a.weight : u < 0.5) ? a.rep : b.rep;
+  c.left = ia;
+  c.right = ib;
+  c.count = a.count + b.count;
+  return c;
+}
+
+// Lays the cluster tree under `root` out as LightNodes: root first, siblings adjacent.
+inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, LightTree& tree) {
+  tree.nodes.clear();
+  tree.nodes.reserve(clusters.size());
+  tree.nodes.push_back(LightNode{});
+  std::vector<std::pair<int32_t, uint32_t>> stack{{root, 0u}};
+  while (!stack.empty()) {
+    auto [ci, ni] = stack.back();
+    stack.pop_back();
+    const Cluster& c = clusters[size_t(ci)];
+    LightNode& n = tree.nodes[ni];
+    n.lo = c.lo;
+    n.hi = c.hi;
+    n.axis = c.axis;
+    n.cosHalfAngle = c.cosHalfAngle;
+    n.intensity = c.intensity;
+    n.rep = c.rep;
+    n.count = c.count;
+    n.left = 0;
+    if (c.left >= 0) {
+      uint32_t j = uint32_t(tree.nodes.size());
+      tree.nodes[ni].left = j;
+      tree.nodes.push_back(LightNode{});
+      tree.nodes.push_back(LightNode{});
+      stack.emplace_back(c.right, j + 1);
+      stack.emplace_back(c.left, j);
+    }
+  }
+}
+
+}  // namespace lc::lightcuts::detail

@@ -1,0 +1,220 @@
+#include "lightcuts/evaluator.h"
+
+#include <algorithm>
+#include <vector>
+
+#include "core/error.h"
+#include "lightcuts/bounds.h"
+
+namespace lc::lightcuts {
+
+Method parseMethod(const std::string& name) {
+  if (name == "brute") return Method::Brute;
+  if (name == "lightcuts") return Method::Lightcuts;
+  if (name == "seed") return Method::Seed;
+  throw Error("unknown method '" + name + "' (use brute, lightcuts or seed)");
+}
+
+const char* methodName(Method m) {
+  switch (m) {
+    case Method::Brute: return "brute";
+    case Method::Lightcuts: return "lightcuts";
+    case Method::Seed: return "seed";
+  }
+  return "?";
+}
+
+namespace {
+
+// M * G * V of one light per unit intensity (one shadow ray when the rest is non-zero).
+inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoint& sp, Visibility& vis,
+                          EvalStats& stats) {
+  Color mg;
+  Vec3 wi;
+  float dist;
+  if (!lightContribution(l, g, sp, mg, wi, dist)) return Color(0);
+  ++stats.shadowRays;
+  return mg * vis(wi, dist);
+}
+
+class BruteForce final : public LightEvaluator {
+ public:
+  explicit BruteForce(const LightSet& lights) : lights_(lights) {}
+  EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const override {
+    Color sum(0);
+    for (const Light& l : lights_.lights)
+      sum += shadowedUnit(l, lights_.groups[l.group], sp, vis, stats) * l.intensity;
+    uint32_t n = uint32_t(lights_.lights.size());
+    stats.recordCut(n);
+    return {sum, n};
+  }
+  Method method() const override { return Method::Brute; }
+
+ private:
+  const LightSet& lights_;
+};
+
+class Lightcuts final : public LightEvaluator {
+ public:
+  Lightcuts(const LightSet& lights, const LightForest& forest, const CutOptions& o)
+      : lights_(lights), forest_(forest), opt_(o) {}
+
+  struct Item {
+    float bound;     // luminance of the error bound
+    uint32_t tree, node;
+    Color unit;      // representative's M*G*V per unit intensity
+    Color estimate;  // unit * cluster intensity
+  };
+
+  EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const override {
+    static thread_local std::vector<Item> heap;
+    heap.clear();
+    auto less = [](const Item& a, const Item& b) { return a.bound < b.bound; };
+    BoundFrames frames(sp);
+    Color total(0);
+    uint32_t cutSize = 0;
+
+    // Adds a node to the cut: its estimate to the total, and to the heap unless exact.
+    auto addNode = [&](uint32_t t, uint32_t ni, const Color& unit) {
+      const LightTree& tree = forest_.trees[t];
+      const LightNode& n = tree.nodes[ni];
+      Color est = unit * n.intensity;
+      total += est;
+      ++cutSize;
+      if (n.isLeaf()) return;
+      ++stats.boundsEvaluated;
+      float b = luminance(clusterBound(n, tree.type, lights_.groups[tree.group], sp, frames));
+      if (b > 0) {
+        heap.push_back(Item{b, t, ni, unit, est});
+        std::push_heap(heap.begin(), heap.end(), less);
+      }
+    };
+
+    for (uint32_t t = 0; t < forest_.trees.size(); ++t) {
+      const LightTree& tree = forest_.trees[t];
+      if (tree.nodes.empty()) continue;
+      const LightNode& root = tree.nodes[0];
+      addNode(t, 0, shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats));
+    }
+    const float eps = opt_.errorRatio;
+    while (!heap.empty()) {
+      const Item& top = heap.front();
+      if (top.bound <= eps * luminance(total) || cutSize >= uint32_t(opt_.maxCut)) break;
+      Item it = top;
+      std::pop_heap(heap.begin(), heap.end(), less);
+      heap.pop_back();
+      total -= it.estimate;
+      --cutSize;
+      const LightTree& tree = forest_.trees[it.tree];
+      const LightGroup& g = lights_.groups[tree.group];
+      const LightNode& n = tree.nodes[it.node];
+      for (uint32_t c = n.left; c <= n.left + 1; ++c) {
+        uint32_t rep = tree.nodes[c].rep;
+        // The child that shares the parent's representative reuses its shadow ray.
+        Color unit = rep == n.rep ? it.unit : shadowedUnit(lights_.lights[rep], g, sp, vis, stats);
+        addNode(it.tree, c, unit);
+      }
+    }
+    stats.recordCut(cutSize);
+    return {vmax(total, Color(0)), cutSize};
+  }
+  Method method() const override { return Method::Lightcuts; }
+
+ private:
+  const LightSet& lights_;
+  const LightForest& forest_;
+  CutOptions opt_;
+};
+
+class SeedCuts final : public LightEvaluator {
+ public:
+  SeedCuts(const LightSet& lights, const LightForest& forest, const CutOptions& o)
+      : lights_(lights), forest_(forest), opt_(o) {}
+
+  EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const override {
+    static thread_local std::vector<std::pair<uint32_t, uint32_t>> stack;
+    stack.clear();
+    Color total(0);
+    uint32_t cutSize = 0;
+    for (uint32_t t = 0; t < forest_.trees.size(); ++t)
+      if (!forest_.trees[t].nodes.empty()) stack.emplace_back(t, 0u);
+    while (!stack.empty()) {
+      auto [t, ni] = stack.back();
+      stack.pop_back();
+      const LightTree& tree = forest_.trees[t];
+      const LightGroup& g = lights_.groups[tree.group];
+      const LightNode& n = tree.nodes[ni];
+      if (!n.isLeaf()) {
+        const SeedNodeData& sd = tree.seed[ni];
+        float dist = tree.type == LightType::Directional ? 1.0f : length(sp.p - sd.position);
+        if (sd.error > opt_.errorRatio * dist && cutSize + stack.size() + 2 <= uint32_t(opt_.maxCut)) {
+          stack.emplace_back(t, n.left);
+          stack.emplace_back(t, n.left + 1);
+          continue;
+        }
+      }
+      bool blocked = false;
+      Color c = nodeLight(tree, g, ni, sp, vis, stats, blocked);
+      if (blocked) {
+        // The seed's fallback: a blocked representative may hide lights that are visible;
+        // its two children (one level only) stand in for it.
+        for (uint32_t k = n.left; k <= n.left + 1; ++k) {
+          bool unused;
+          total += nodeLight(tree, g, k, sp, vis, stats, unused);
+        }
+        cutSize += 2;
+        continue;
+      }
+      total += c;
+      ++cutSize;
+    }
+    stats.recordCut(cutSize);
+    return {total, cutSize};
+  }
+  Method method() const override { return Method::Seed; }
+
+ private:
+  // The contribution of a node's light: the light itself at a leaf, the synthetic
+  // centroid light otherwise. `blocked` is set when an inner node's light is non-zero but
+  // fully occluded.
+  Color nodeLight(const LightTree& tree, const LightGroup& g, uint32_t ni, const ShadingPoint& sp,
+                  Visibility& vis, EvalStats& stats, bool& blocked) const {
+    const LightNode& n = tree.nodes[ni];
+    blocked = false;
+    if (n.isLeaf()) return shadowedUnit(lights_.lights[n.rep], g, sp, vis, stats) * n.intensity;
+    const SeedNodeData& sd = tree.seed[ni];
+    Light syn;
+    syn.type = tree.type;
+    syn.group = tree.group;
+    syn.position = sd.position;
+    syn.direction = tree.type == LightType::Directional ? -normalize(sd.position) : sd.direction;
+    Color mg;
+    Vec3 wi;
+    float dist;
+    if (!lightContribution(syn, g, sp, mg, wi, dist)) return Color(0);
+    ++stats.shadowRays;
+    Color v = vis(wi, dist);
+    blocked = isBlack(v);
+    return mg * v * n.intensity;
+  }
+
+  const LightSet& lights_;
+  const LightForest& forest_;
+  CutOptions opt_;
+};
+
+}  // namespace
+
+std::unique_ptr<LightEvaluator> makeBruteForce(const LightSet& lights) {
+  return std::make_unique<BruteForce>(lights);
+}
+std::unique_ptr<LightEvaluator> makeLightcuts(const LightSet& lights, const LightForest& forest,
+                                              const CutOptions& options) {
+  return std::make_unique<Lightcuts>(lights, forest, options);
+}
+std::unique_ptr<LightEvaluator> makeSeedCuts(const LightSet& lights, const LightForest& forest,
+                                             const CutOptions& options) {
+  return std::make_unique<SeedCuts>(lights, forest, options);
+}
+
+}  // namespace lc::lightcuts

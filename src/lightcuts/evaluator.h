@@ -1,0 +1,76 @@
+// Light evaluators: the direct light at a shading point from every light of a LightSet,
+// computed three ways that share one light model and one exact contribution function.
+//   brute      every light, exactly: the reference.
+//   lightcuts  Walter et al. 2005: a cut through the light tree chosen per point by a
+//              max-heap on the clusters' error upper bounds, refined until every bound is
+//              below errorRatio times the current estimate (or maxCut nodes).
+//   seed       the course project's traversal: descend while a node's error radius over
+//              its distance exceeds errorRatio; a blocked representative is replaced by its
+//              two children (one level, not recursively).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "lightcuts/light_tree.h"
+#include "lightcuts/shading.h"
+#include "scene/light.h"
+
+namespace lc::lightcuts {
+
+enum class Method { Brute, Lightcuts, Seed };
+Method parseMethod(const std::string& name);  // "brute" | "lightcuts" | "seed"
+const char* methodName(Method m);
+
+struct CutOptions {
+  float errorRatio = 0.02f;  // --error: relative error threshold
+  int maxCut = 1000;         // --max-cut: most nodes in one cut
+};
+
+// Counters summed over shading points (per thread, then merged).
+struct EvalStats {
+  static constexpr int kHistogramBuckets = 24;  // cut sizes in [2^(i-1), 2^i), bucket 0 = 0
+  uint64_t shadingPoints = 0;
+  uint64_t cutNodes = 0;         // nodes (lights or clusters) in the cuts
+  uint64_t shadowRays = 0;
+  uint64_t boundsEvaluated = 0;
+  std::array<uint64_t, kHistogramBuckets> cutHistogram{};
+
+  void recordCut(uint32_t size) {
+    ++shadingPoints;
+    cutNodes += size;
+    int b = 0;
+    while (b + 1 < kHistogramBuckets && (uint64_t(1) << b) <= size) ++b;
+    ++cutHistogram[size_t(b)];
+  }
+  void add(const EvalStats& o) {
+    shadingPoints += o.shadingPoints;
+    cutNodes += o.cutNodes;
+    shadowRays += o.shadowRays;
+    boundsEvaluated += o.boundsEvaluated;
+    for (size_t i = 0; i < cutHistogram.size(); ++i) cutHistogram[i] += o.cutHistogram[i];
+  }
+};
+
+struct EvalResult {
+  Color radiance;
+  uint32_t cutSize = 0;
+};
+
+class LightEvaluator {
+ public:
+  virtual ~LightEvaluator() = default;
+  virtual EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const = 0;
+  virtual Method method() const = 0;
+};
+
+// `lights` (and `forest`) must outlive the evaluator.
+std::unique_ptr<LightEvaluator> makeBruteForce(const LightSet& lights);
+std::unique_ptr<LightEvaluator> makeLightcuts(const LightSet& lights, const LightForest& forest,
+                                              const CutOptions& options);
+std::unique_ptr<LightEvaluator> makeSeedCuts(const LightSet& lights, const LightForest& forest,
+                                             const CutOptions& options);
+
+}  // namespace lc::lightcuts

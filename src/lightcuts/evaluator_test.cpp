@@ -1,0 +1,176 @@
+#include "lightcuts/evaluator.h"
+
+#include <gtest/gtest.h>
+
+#include "core/error.h"
+#include "core/rng.h"
+
+namespace lc::lightcuts {
+namespace {
+
+struct Unoccluded : Visibility {
+  Color operator()(const Vec3&, float) override { return Color(1); }
+};
+
+// Blocks every direction with a negative x component (half the lights of a sphere).
+struct HalfBlocked : Visibility {
+  Color operator()(const Vec3& wi, float) override { return wi.x < 0 ? Color(0) : Color(1); }
+};
+
+LightSet cloud(size_t n, LightType type, uint64_t seed) {
+  LightSet s;
+  s.groups.push_back(LightGroup{});
+  Rng r(seed, 2);
+  for (size_t i = 0; i < n; ++i) {
+    Light l;
+    l.type = type;
+    l.position = Vec3(r.uniform() * 4 - 2, 2 + r.uniform(), r.uniform() * 4 - 2);
+    l.direction = normalize(Vec3(r.uniform() - 0.5f, -1, r.uniform() - 0.5f));
+    l.intensity = Color(r.uniform(), r.uniform(), r.uniform()) * 0.01f;
+    s.lights.push_back(l);
+  }
+  return s;
+}
+
+ShadingPoint point(Vec3 p) {
+  ShadingPoint sp;
+  sp.p = p;
+  sp.n = Vec3(0, 1, 0);
+  sp.r = normalize(Vec3(0.3f, 1, 0.1f));
+  sp.kd = Color(0.7f, 0.6f, 0.5f);
+  sp.ks = Color(0.3f);
+  sp.shininess = 10;
+  return sp;
+}
+
+TEST(BruteForce, SumsEveryLight) {
+  LightSet s = cloud(50, LightType::Omni, 1);
+  auto bf = makeBruteForce(s);
+  Unoccluded vis;
+  EvalStats st;
+  ShadingPoint sp = point(Vec3(0, 0, 0));
+  EvalResult r = bf->evaluate(sp, vis, st);
+  Color expect(0);
+  for (const Light& l : s.lights) {
+    Color mg;
+    Vec3 wi;
+    float d;
+    if (lightContribution(l, s.groups[0], sp, mg, wi, d)) expect += mg * l.intensity;
+  }
+  EXPECT_NEAR(r.radiance.x, expect.x, 1e-6f);
+  EXPECT_NEAR(r.radiance.y, expect.y, 1e-6f);
+  EXPECT_EQ(r.cutSize, 50u);
+  EXPECT_EQ(st.shadowRays, 50u);
+}
+
+// One point light over a plane: the closed form of the course's Phong model.
+TEST(BruteForce, MatchesClosedFormPhong) {
+  LightSet s;
+  LightGroup g;
+  g.atten = Attenuation{0.2f, 0.3f, 0.1f, kInf};
+  s.groups.push_back(g);
+  Light l;
+  l.position = Vec3(1, 2, 0);
+  l.intensity = Color(1, 0.5f, 0.25f);
+  s.lights.push_back(l);
+  ShadingPoint sp = point(Vec3(0, 0, 0));
+  auto bf = makeBruteForce(s);
+  Unoccluded vis;
+  EvalStats st;
+  Color got = bf->evaluate(sp, vis, st).radiance;
+  float d = std::sqrt(5.0f);
+  Vec3 L = Vec3(1, 2, 0) / d;
+  float atten = std::min(1.0f, 1 / (0.2f + 0.3f * d + 0.1f * d * d));
+  Color expect = (sp.kd * dot(sp.n, L) + sp.ks * std::pow(dot(sp.r, L), 10.0f)) * atten * l.intensity;
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], expect[c], 1e-6f);
+}
+
+class CutMethods : public ::testing::TestWithParam<LightType> {};
+
+TEST_P(CutMethods, LeafCutEqualsBruteForce) {
+  LightSet s = cloud(300, GetParam(), 3);
+  LightForest f = buildLightForest(s);
+  auto bf = makeBruteForce(s);
+  auto lcut = makeLightcuts(s, f, CutOptions{0.0f, 1 << 30});
+  HalfBlocked vis;
+  EvalStats st;
+  for (int i = 0; i < 20; ++i) {
+    ShadingPoint sp = point(Vec3(float(i) * 0.2f - 2, 0, 0.1f * float(i)));
+    Color a = bf->evaluate(sp, vis, st).radiance;
+    EvalResult b = lcut->evaluate(sp, vis, st);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b.radiance[c], 1e-5f * (a[c] + 1e-6f));
+  }
+}
+
+TEST_P(CutMethods, ErrorStaysNearTheThresholdAndCutsAreSmall) {
+  LightSet s = cloud(20000, GetParam(), 4);
+  LightForest f = buildLightForest(s);
+  auto bf = makeBruteForce(s);
+  auto lcut = makeLightcuts(s, f, CutOptions{0.02f, 1000});
+  Unoccluded vis;
+  EvalStats st, stl;
+  double worst = 0, sum = 0;
+  for (int i = 0; i < 20; ++i) {
+    ShadingPoint sp = point(Vec3(float(i) * 0.3f - 3, 0, 0.2f * float(i) - 2));
+    Color a = bf->evaluate(sp, vis, st).radiance;
+    Color b = lcut->evaluate(sp, vis, stl).radiance;
+    double rel = std::fabs(luminance(a) - luminance(b)) / luminance(a);
+    worst = std::max(worst, rel);
+    sum += rel;
+  }
+  // Each node of the cut is within 2% of the total, so the total error is bounded by the
+  // sum of the cut's bounds; this cloud of equally distant lights is the hard case where
+  // many nodes sit near the threshold. The error still averages under it.
+  EXPECT_LT(sum / 20, 0.02);
+  EXPECT_LT(worst, 0.06);
+  EXPECT_LT(double(stl.cutNodes) / double(stl.shadingPoints), 0.05 * 20000);
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, CutMethods, ::testing::Values(LightType::Omni, LightType::Oriented),
+                         [](const auto& info) { return std::string(lightTypeName(info.param)); });
+
+TEST(SeedCuts, ZeroThresholdReachesEveryLight) {
+  LightSet s = cloud(200, LightType::Omni, 5);
+  LightForest f = buildLightForest(s, TreeBuildOptions{TreeBuilder::Seed, 1});
+  auto bf = makeBruteForce(s);
+  auto seed = makeSeedCuts(s, f, CutOptions{0.0f, 1 << 30});
+  Unoccluded vis;
+  EvalStats st;
+  ShadingPoint sp = point(Vec3(0.5f, 0, 0));
+  Color a = bf->evaluate(sp, vis, st).radiance;
+  EvalResult b = seed->evaluate(sp, vis, st);
+  EXPECT_EQ(b.cutSize, 200u);
+  EXPECT_NEAR(luminance(a), luminance(b.radiance), 1e-5f * luminance(a));
+}
+
+TEST(SeedCuts, BlockedRepresentativeFallsBackToChildren) {
+  LightSet s;
+  s.groups.push_back(LightGroup{});
+  for (float x : {-1.0f, 1.0f}) {
+    Light l;
+    l.position = Vec3(x, 5, 0);
+    l.intensity = Color(1);
+    s.lights.push_back(l);
+  }
+  LightForest f = buildLightForest(s, TreeBuildOptions{TreeBuilder::Seed, 1});
+  // The centroid (0,5,0) is straight up and blocked; the child at x = +1 is visible.
+  struct BlockUp : Visibility {
+    Color operator()(const Vec3& wi, float) override { return std::fabs(wi.x) < 1e-3f ? Color(0) : Color(1); }
+  } vis;
+  auto seed = makeSeedCuts(s, f, CutOptions{10.0f, 1000});
+  EvalStats st;
+  ShadingPoint sp = point(Vec3(0, 0, 0));
+  sp.ks = Color(0);
+  EvalResult r = seed->evaluate(sp, vis, st);
+  EXPECT_EQ(r.cutSize, 2u);
+  EXPECT_GT(luminance(r.radiance), 0.0f);
+}
+
+TEST(Methods, ParseNames) {
+  EXPECT_EQ(parseMethod("brute"), Method::Brute);
+  EXPECT_EQ(parseMethod("seed"), Method::Seed);
+  EXPECT_THROW(parseMethod("fast"), Error);
+}
+
+}  // namespace
+}  // namespace lc::lightcuts

@@ -1,0 +1,170 @@
+#include "lightcuts/light_tree.h"
+
+#include <tbb/parallel_for.h>
+
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "core/error.h"
+
+namespace lc::lightcuts {
+
+size_t LightForest::memoryBytes() const {
+  size_t b = 0;
+  for (const LightTree& t : trees)
+    b += t.nodes.size() * sizeof(LightNode) + t.seed.size() * sizeof(SeedNodeData);
+  return b;
+}
+
+size_t LightForest::nodeCount() const {
+  size_t n = 0;
+  for (const LightTree& t : trees) n += t.nodes.size();
+  return n;
+}
+
+TreeBuilder parseTreeBuilder(const std::string& name) {
+  if (name == "walter" || name == "agglomerative") return TreeBuilder::Agglomerative;
+  if (name == "seed") return TreeBuilder::Seed;
+  throw Error("unknown light tree builder '" + name + "' (use walter or seed)");
+}
+
+const char* treeBuilderName(TreeBuilder b) {
+  return b == TreeBuilder::Seed ? "seed" : "walter";
+}
+
+void coneUnion(const Vec3& a, float cosA, const Vec3& b, float cosB, Vec3& axis, float& cosOut) {
+  if (cosA <= -1 || cosB <= -1) {
+    axis = a;
+    cosOut = -1;
+    return;
+  }
+  float thetaA = std::acos(std::clamp(cosA, -1.0f, 1.0f));
+  float thetaB = std::acos(std::clamp(cosB, -1.0f, 1.0f));
+  float thetaD = std::acos(std::clamp(dot(a, b), -1.0f, 1.0f));
+  if (std::min(thetaD + thetaB, kPi) <= thetaA) {
+    axis = a;
+    cosOut = cosA;
+    return;
+  }
+  if (std::min(thetaD + thetaA, kPi) <= thetaB) {
+    axis = b;
+    cosOut = cosB;
+    return;
+  }
+  float thetaO = (thetaA + thetaD + thetaB) * 0.5f;
+  if (thetaO >= kPi) {
+    axis = a;
+    cosOut = -1;
+    return;
+  }
+  // Rotate a toward b by thetaO - thetaA about a x b (Rodrigues).
+  Vec3 k = cross(a, b);
+  float kl = length(k);
+  if (kl < 1e-12f) {
+    axis = a;
+    cosOut = -1;
+    return;
+  }
+  k = k / kl;
+  float thetaR = thetaO - thetaA;
+  float c = std::cos(thetaR), s = std::sin(thetaR);
+  axis = normalize(a * c + cross(k, a) * s + k * (dot(k, a) * (1 - c)));
+  // Round outward: the cone must contain both inputs despite float error.
+  cosOut = std::max(-1.0f, std::cos(thetaO) - 1e-6f);
+}
+
+namespace {
+
+struct GroupKey {
+  LightType type;
+  uint16_t group;
+  bool operator<(const GroupKey& o) const {
+    return type != o.type ? type < o.type : group < o.group;
+  }
+};
+
+}  // namespace
+
+void computeSeedData(const LightSet& lights, LightTree& tree) {
+  // Bottom-up. Children always have larger indices than their parent in our layout, so a
+  // reverse sweep visits children first. The mean distance to the centroid is exact for
+  // leaves and bounded above through the triangle inequality for inner nodes; the seed
+  // builder overwrites it with exact values.
+  std::vector<SeedNodeData>& sd = tree.seed;
+  std::vector<float> spread(tree.nodes.size(), 0.0f);
+  sd.assign(tree.nodes.size(), SeedNodeData{});
+  auto chroma = [](const Color& c) {
+    float s = c.x + c.y + c.z;
+    return s > 0 ? c / s : Color(1.0f / 3);
+  };
+  for (size_t i = tree.nodes.size(); i-- > 0;) {
+    const LightNode& n = tree.nodes[i];
+    SeedNodeData& d = sd[i];
+    if (n.isLeaf()) {
+      const Light& l = lights.lights[n.rep];
+      d.position = l.type == LightType::Directional ? -l.direction : l.position;
+      d.direction = l.direction;
+      d.error = 0;
+      continue;
+    }
+    const LightNode& a = tree.nodes[n.left];
+    const LightNode& b = tree.nodes[n.left + 1];
+    const SeedNodeData& da = sd[n.left];
+    const SeedNodeData& db = sd[n.left + 1];
+    float wa = luminance(a.intensity), wb = luminance(b.intensity);
+    float w = wa + wb;
+    if (!(w > 0)) { wa = wb = 0.5f; w = 1; }
+    d.position = (da.position * wa + db.position * wb) / w;
+    Vec3 dir = da.direction * wa + db.direction * wb;
+    d.direction = length2(dir) > 0 ? normalize(dir) : da.direction;
+    float meanDist = (wa * (da.error / (1 + spread[n.left]) + length(da.position - d.position)) +
+                      wb * (db.error / (1 + spread[n.left + 1]) + length(db.position - d.position))) / w;
+    Color cm = chroma(n.intensity);
+    Vec3 ca = vabs(chroma(a.intensity) - cm), cb = vabs(chroma(b.intensity) - cm);
+    spread[i] = (wa * (spread[n.left] + ca.x + ca.y + ca.z) + wb * (spread[n.left + 1] + cb.x + cb.y + cb.z)) / w;
+    d.error = meanDist * (1 + spread[i]);
+  }
+}
+
+LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& options) {
+  auto t0 = std::chrono::steady_clock::now();
+  std::map<GroupKey, std::vector<uint32_t>> groups;
+  for (size_t i = 0; i < lights.lights.size(); ++i) {
+    const Light& l = lights.lights[i];
+    if (!(luminance(l.intensity) > 0)) continue;
+    groups[GroupKey{l.type, l.group}].push_back(uint32_t(i));
+  }
+  LightForest forest;
+  forest.trees.resize(groups.size());
+  std::vector<std::pair<GroupKey, const std::vector<uint32_t>*>> work;
+  for (auto& [k, v] : groups) work.emplace_back(k, &v);
+  // Trees are independent; build them side by side (each builder is itself parallel).
+  tbb::parallel_for(size_t(0), work.size(), [&](size_t i) {
+    const GroupKey& k = work[i].first;
+    const std::vector<uint32_t>& idx = *work[i].second;
+    uint64_t seed = options.seed * 0x9E3779B97F4A7C15ull + i;
+    LightTree t;
+    if (options.builder == TreeBuilder::Seed) {
+      t = buildSeedTree(lights, idx, k.type, seed);
+    } else {
+      // c weights the normal cone for lights whose emission depends on direction.
+      float c = 0;
+      if (k.type == LightType::Oriented || k.type == LightType::Spot) {
+        Bounds3 b;
+        for (uint32_t li : idx) b.extend(lights.lights[li].position);
+        c = b.diagonal();
+      }
+      t = buildAgglomerativeTree(lights, idx, k.type, c, seed, std::max<size_t>(options.exactLimit, 2));
+      computeSeedData(lights, t);
+    }
+    t.type = k.type;
+    t.group = k.group;
+    forest.trees[i] = std::move(t);
+  });
+  forest.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return forest;
+}
+
+}  // namespace lc::lightcuts

@@ -1,0 +1,98 @@
+// Light trees: binary trees of light clusters. Each node stores what the Lightcuts error
+// bounds need (bounding box, cone of light normals, summed intensity, a representative
+// light) and, in a parallel array, what the seed's traversal needs (intensity-weighted
+// centroid and direction, and its error radius).
+//
+// Two builders:
+//   Agglomerative (Walter et al. 2005, built the fast way of Walter et al. 2008): greedily
+//     merge the pair whose union minimises I * (alpha^2 + c^2 (1 - cos beta)^2), found by
+//     nearest-neighbour search in a k-d tree over clusters and a heap of best pairs.
+//   Seed (the course project's k-d split): recursive split over x, y, z at the position that
+//     balances the halves and falls at the largest gap in position and colour.
+// One tree per (light type, light group): clusters never mix attenuation or falloff.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+#include "scene/light.h"
+
+namespace lc::lightcuts {
+
+// 64 bytes: one cache line.
+struct LightNode {
+  Vec3 lo, hi;          // bounds of light positions (directional trees: of directions to the light)
+  Vec3 axis;            // cone of light normals/axes (oriented, spot); unit
+  float cosHalfAngle;   // cone half-angle's cosine; -1 = all directions
+  Color intensity;      // summed RGB intensity of the cluster
+  uint32_t rep;         // representative light (index into LightSet::lights)
+  uint32_t left;        // first child (the second is left + 1); 0 = leaf
+  uint32_t count;       // lights in the cluster
+  bool isLeaf() const { return left == 0; }
+};
+static_assert(sizeof(LightNode) == 64, "LightNode should fill one cache line");
+
+// Per-node data of the seed's traversal: a synthetic light at the intensity-weighted
+// centroid, and the node's error radius.
+struct SeedNodeData {
+  Vec3 position;   // weighted centroid (directional: weighted mean direction)
+  Vec3 direction;  // weighted mean normal/axis, unit
+  float error;     // weighted mean distance to the centroid, scaled by the colour spread
+};
+
+struct LightTree {
+  LightType type = LightType::Omni;
+  uint16_t group = 0;
+  std::vector<LightNode> nodes;  // nodes[0] is the root
+  std::vector<SeedNodeData> seed;  // parallel to nodes
+};
+
+enum class TreeBuilder { Agglomerative, Seed };
+
+struct TreeBuildOptions {
+  TreeBuilder builder = TreeBuilder::Agglomerative;
+  uint64_t seed = 1;  // representative choice
+  // Agglomerative: light sets up to this size are clustered exactly (greedy); larger ones
+  // bottom-up in Morton-ordered groups first (see agglomerative_build.cpp).
+  size_t exactLimit = 8192;
+};
+
+struct LightForest {
+  std::vector<LightTree> trees;
+  double buildSeconds = 0;
+  size_t memoryBytes() const;
+  size_t nodeCount() const;
+};
+
+// Builds one tree per (type, group) over the lights with non-zero intensity.
+LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& options = {});
+
+TreeBuilder parseTreeBuilder(const std::string& name);  // "walter" | "agglomerative" | "seed"
+const char* treeBuilderName(TreeBuilder b);
+
+// ---- building blocks, exposed for tests ----
+
+// Smallest cone containing both cones (pbrt-v4's DirectionCone union).
+void coneUnion(const Vec3& a, float cosA, const Vec3& b, float cosB, Vec3& axis, float& cosOut);
+
+// The agglomerative metric of a cluster: I * (diag^2 + c^2 (1 - cos beta)^2).
+inline float clusterMetric(float intensity, const Vec3& lo, const Vec3& hi, float cosHalfAngle,
+                           float c) {
+  Vec3 e = hi - lo;
+  float a = 1 - cosHalfAngle;
+  return intensity * (dot(e, e) + c * c * a * a);
+}
+
+// Builders over a list of light indices of one type and group (used by buildLightForest).
+LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint32_t>& indices,
+                                 LightType type, float coneWeight, uint64_t seed,
+                                 size_t exactLimit = 8192);
+LightTree buildSeedTree(const LightSet& lights, const std::vector<uint32_t>& indices, LightType type,
+                        uint64_t seed);
+
+// Fills LightTree::seed from the finished nodes (centroids, mean directions, errors).
+void computeSeedData(const LightSet& lights, LightTree& tree);
+
+}  // namespace lc::lightcuts

@@ -1,0 +1,171 @@
+#include "lightcuts/light_tree.h"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <set>
+
+#include "core/rng.h"
+
+namespace lc::lightcuts {
+namespace {
+
+LightSet randomLights(size_t n, LightType type, uint64_t seed, bool coloured = false) {
+  LightSet s;
+  s.groups.push_back(LightGroup{});
+  Rng r(seed, 1);
+  for (size_t i = 0; i < n; ++i) {
+    Light l;
+    l.type = type;
+    l.position = Vec3(r.uniform(), r.uniform(), r.uniform()) * 10;
+    l.direction = normalize(Vec3(r.uniform() - 0.5f, r.uniform() - 0.5f, r.uniform() - 0.5f));
+    l.intensity = coloured ? Color(r.uniform(), r.uniform(), r.uniform()) + Color(0.01f) : Color(1);
+    s.lights.push_back(l);
+  }
+  return s;
+}
+
+// Every node's box, cone, intensity and count must cover its children, and every light
+// must sit in exactly one leaf.
+void checkTree(const LightSet& set, const LightTree& t) {
+  std::set<uint32_t> leaves;
+  std::function<void(uint32_t)> visit = [&](uint32_t i) {
+    const LightNode& n = t.nodes[i];
+    if (n.isLeaf()) {
+      EXPECT_TRUE(leaves.insert(n.rep).second) << "light in two leaves";
+      EXPECT_EQ(n.count, 1u);
+      const Light& l = set.lights[n.rep];
+      Vec3 p = l.type == LightType::Directional ? -l.direction : l.position;
+      EXPECT_EQ(n.lo, p);
+      return;
+    }
+    const LightNode& a = t.nodes[n.left];
+    const LightNode& b = t.nodes[n.left + 1];
+    EXPECT_GT(n.left, i) << "children come after parents";
+    EXPECT_EQ(n.count, a.count + b.count);
+    EXPECT_TRUE(n.rep == a.rep || n.rep == b.rep) << "representative comes from a child";
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_LE(n.lo[k], std::min(a.lo[k], b.lo[k]));
+      EXPECT_GE(n.hi[k], std::max(a.hi[k], b.hi[k]));
+      EXPECT_NEAR(n.intensity[k], a.intensity[k] + b.intensity[k], 1e-4f * n.intensity[k] + 1e-6f);
+    }
+    if (t.type == LightType::Oriented) {
+      const Light& la = set.lights[a.rep];
+      EXPECT_GE(dot(la.direction, n.axis), n.cosHalfAngle - 1e-4f);
+    }
+    visit(n.left);
+    visit(n.left + 1);
+  };
+  ASSERT_FALSE(t.nodes.empty());
+  visit(0);
+  EXPECT_EQ(t.nodes.size(), 2 * leaves.size() - 1);
+}
+
+class TreeBuild : public ::testing::TestWithParam<std::tuple<TreeBuilder, LightType>> {};
+
+TEST_P(TreeBuild, IsAValidClusterHierarchy) {
+  auto [builder, type] = GetParam();
+  for (size_t n : {1u, 2u, 3u, 17u, 1000u}) {
+    LightSet set = randomLights(n, type, n, true);
+    LightForest f = buildLightForest(set, TreeBuildOptions{builder, 5});
+    ASSERT_EQ(f.trees.size(), 1u);
+    checkTree(set, f.trees[0]);
+    ASSERT_EQ(f.trees[0].seed.size(), f.trees[0].nodes.size());
+  }
+}
+
+TEST_P(TreeBuild, IsDeterministic) {
+  auto [builder, type] = GetParam();
+  LightSet set = randomLights(5000, type, 77, true);
+  LightForest a = buildLightForest(set, TreeBuildOptions{builder, 5});
+  LightForest b = buildLightForest(set, TreeBuildOptions{builder, 5});
+  ASSERT_EQ(a.trees[0].nodes.size(), b.trees[0].nodes.size());
+  for (size_t i = 0; i < a.trees[0].nodes.size(); ++i) {
+    ASSERT_EQ(a.trees[0].nodes[i].rep, b.trees[0].nodes[i].rep);
+    ASSERT_EQ(a.trees[0].nodes[i].left, b.trees[0].nodes[i].left);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    All, TreeBuild,
+    ::testing::Combine(::testing::Values(TreeBuilder::Agglomerative, TreeBuilder::Seed),
+                       ::testing::Values(LightType::Omni, LightType::Oriented, LightType::Directional)),
+    [](const auto& info) {
+      return std::string(treeBuilderName(std::get<0>(info.param))) + "_" +
+             lightTypeName(std::get<1>(info.param));
+    });
+
+TEST(TreeBuild, SeparatesGroupsAndTypes) {
+  LightSet set = randomLights(100, LightType::Omni, 1);
+  for (size_t i = 0; i < 30; ++i) set.lights[i].type = LightType::Oriented;
+  LightGroup g2;
+  g2.atten = Attenuation{1, 0, 0, kInf};
+  uint16_t gi = set.groupFor(g2);
+  for (size_t i = 30; i < 50; ++i) set.lights[i].group = gi;
+  LightForest f = buildLightForest(set);
+  ASSERT_EQ(f.trees.size(), 3u);
+  size_t total = 0;
+  for (const LightTree& t : f.trees) total += t.nodes[0].count;
+  EXPECT_EQ(total, 100u);
+}
+
+TEST(TreeBuild, SkipsLightsWithoutIntensity) {
+  LightSet set = randomLights(10, LightType::Omni, 1);
+  set.lights[3].intensity = Color(0);
+  LightForest f = buildLightForest(set);
+  EXPECT_EQ(f.trees[0].nodes[0].count, 9u);
+}
+
+// Agglomerative clustering must merge the two obvious groups last.
+TEST(Agglomerative, MergesNearbyLightsFirst) {
+  LightSet set;
+  set.groups.push_back(LightGroup{});
+  for (int g = 0; g < 2; ++g)
+    for (int i = 0; i < 8; ++i) {
+      Light l;
+      l.position = Vec3(float(g) * 100 + float(i) * 0.1f, 0, 0);
+      l.intensity = Color(1);
+      set.lights.push_back(l);
+    }
+  LightForest f = buildLightForest(set);
+  const LightTree& t = f.trees[0];
+  EXPECT_EQ(t.nodes[t.nodes[0].left].count, 8u);
+  EXPECT_EQ(t.nodes[t.nodes[0].left + 1].count, 8u);
+}
+
+// The seed split falls at a gap in position rather than at the median.
+TEST(SeedBuild, SplitsAtTheLargestGap) {
+  LightSet set;
+  set.groups.push_back(LightGroup{});
+  for (int i = 0; i < 12; ++i) {
+    Light l;
+    l.position = Vec3(i < 5 ? float(i) : 50 + float(i), 0, 0);
+    l.intensity = Color(1);
+    set.lights.push_back(l);
+  }
+  LightForest f = buildLightForest(set, TreeBuildOptions{TreeBuilder::Seed, 1});
+  const LightTree& t = f.trees[0];
+  uint32_t a = t.nodes[t.nodes[0].left].count, b = t.nodes[t.nodes[0].left + 1].count;
+  EXPECT_EQ(std::min(a, b), 5u);
+  // The seed error of a node of coincident equal lights is zero; of spread lights positive.
+  EXPECT_GT(t.seed[0].error, 0.0f);
+}
+
+TEST(SeedBuild, ErrorIsWeightedMeanDistanceToCentroid) {
+  LightSet set;
+  set.groups.push_back(LightGroup{});
+  for (float x : {0.0f, 2.0f}) {
+    Light l;
+    l.position = Vec3(x, 0, 0);
+    l.intensity = Color(1);
+    set.lights.push_back(l);
+  }
+  LightForest f = buildLightForest(set, TreeBuildOptions{TreeBuilder::Seed, 1});
+  EXPECT_FLOAT_EQ(f.trees[0].seed[0].error, 1.0f);  // same colour: no spread factor
+  EXPECT_EQ(f.trees[0].seed[0].position, Vec3(1, 0, 0));
+}
+
+TEST(Nodes, AreCompact) { EXPECT_LE(sizeof(LightNode), 64u); }
+
+}  // namespace
+}  // namespace lc::lightcuts

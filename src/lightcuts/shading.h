@@ -1,0 +1,69 @@
+// The receiving side of a light evaluation, and the exact contribution of one light.
+// Brute force, the Lightcuts estimate and the seed's cuts all call lightContribution(), so
+// the three methods agree exactly wherever a cut reaches single lights.
+#pragma once
+
+#include <cmath>
+
+#include "core/math.h"
+#include "scene/light.h"
+
+namespace lc::lightcuts {
+
+// Everything the course's Phong model needs at a shading point:
+//   M = kd*max(N.L,0) + ks*max(R.L,0)^shininess   (no light from behind: N.L <= 0 gives 0)
+// with R the mirror of the view direction about N (so R.L equals the course's R_L.V).
+struct ShadingPoint {
+  Vec3 p;          // position
+  Vec3 n;          // unit shading normal, facing the viewer
+  Vec3 r;          // unit mirror direction of the view vector about n
+  Color kd, ks;
+  float shininess = 0;
+
+  bool hasSpecular() const { return !isBlack(ks); }
+  bool isBlackBody() const { return isBlack(kd) && isBlack(ks); }
+};
+
+// Visibility from the shading point toward a light: 1 when unoccluded, 0 when blocked,
+// the transmissive colour product through glass. Implemented by the renderer.
+class Visibility {
+ public:
+  virtual ~Visibility() = default;
+  // wi: unit direction to the light; dist: distance to it (infinity for directional).
+  virtual Color operator()(const Vec3& wi, float dist) = 0;
+};
+
+// M * G of one light per unit intensity, without visibility. Returns false when the
+// contribution is exactly zero (then no shadow ray is needed).
+inline bool lightContribution(const Light& l, const LightGroup& g, const ShadingPoint& sp,
+                              Color& mg, Vec3& wi, float& dist) {
+  float G;
+  if (l.type == LightType::Directional) {
+    wi = -l.direction;
+    dist = kInf;
+    G = 1;
+  } else {
+    Vec3 d = l.position - sp.p;
+    float d2 = length2(d);
+    if (!(d2 > 0)) return false;
+    dist = std::sqrt(d2);
+    wi = d / dist;
+    G = g.atten(dist);
+    if (l.type == LightType::Oriented)
+      G *= std::max(0.0f, -dot(l.direction, wi));
+    else if (l.type == LightType::Spot)
+      G *= g.falloff(-dot(l.direction, wi));
+  }
+  if (!(G > 0)) return false;
+  float cosN = dot(sp.n, wi);
+  if (!(cosN > 0)) return false;
+  Color m = sp.kd * cosN;
+  if (!g.diffuseOnly && sp.hasSpecular()) {
+    float cosR = std::max(0.0f, dot(sp.r, wi));
+    if (cosR > 0 || sp.shininess == 0) m += sp.ks * std::pow(cosR, sp.shininess);
+  }
+  mg = m * G;
+  return !isBlack(mg);
+}
+
+}  // namespace lc::lightcuts

@@ -1,0 +1,46 @@
+// Object lights: every object whose material has a `luminosity` becomes many point lights
+// on its surface (the seed's "object lights"). See docs/SCENE_FORMAT.md for the keyword.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scene/scene.h"
+
+namespace lc::lights {
+
+enum class ObjectLightKind {
+  Oriented,  // emit max(cos, 0) about the outward surface normal (default; both sides of a square)
+  Omni,      // the seed's omni lights
+};
+enum class Placement {
+  Stratified,  // area-uniform low-discrepancy samples over each triangle (default)
+  Seed,        // the seed's pattern: centroid, then along centroid-vertex lines, then between
+};
+
+ObjectLightKind parseObjectLightKind(const std::string& s);
+Placement parsePlacement(const std::string& s);
+
+struct ObjectLightOptions {
+  ObjectLightKind kind = ObjectLightKind::Oriented;
+  Placement placement = Placement::Stratified;
+  uint64_t maxLights = 20'000'000;  // --max-lights
+  uint64_t seed = 1;
+};
+
+// What was generated for one luminous object (for `lightcuts info` and --stats).
+struct ObjectLightInfo {
+  int shape = -1;
+  std::string name;
+  uint64_t lights = 0;
+  double area = 0;   // world-space surface area
+  Color power;       // total emitted intensity (sum of the lights' intensities)
+};
+
+// Appends the lights of every luminous object to scene.lights(). Throws lc::Error (with the
+// luminosity's file:line:column) for bad values or when --max-lights would be exceeded,
+// before allocating anything.
+std::vector<ObjectLightInfo> addObjectLights(scene::Scene& scene, const ObjectLightOptions& options);
+
+}  // namespace lc::lights

@@ -1,0 +1,70 @@
+// The Whitted-style renderer: camera rays per pixel (stratified supersampling), Phong
+// shading with direct light from a pluggable LightEvaluator (brute force, Lightcuts or the
+// seed's cuts), reflection and refraction by recursion. Tiles render in parallel with
+// oneTBB; every pixel draws from its own random stream, so the image is the same bit for
+// bit at any thread count.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "io/image.h"
+#include "lightcuts/evaluator.h"
+#include "scene/scene.h"
+
+namespace lc::render {
+
+struct RenderOptions {
+  int width = 512;
+  int height = 512;
+  int spp = 1;        // samples per pixel, stratified; 1 = the pixel centre
+  int threads = 0;    // 0 = all cores
+  int maxDepth = 5;   // reflection/refraction recursion depth
+  uint64_t seed = 1;
+  // Also evaluate K pixels (spread over the image) with brute force, to report the
+  // measured error and the brute-force time the full image would take.
+  int referencePixels = 0;
+  // Set from a signal handler to stop early; the result is marked interrupted.
+  std::atomic<bool>* cancel = nullptr;
+  // Called from one thread with the fraction done (0..1), about ten times a second.
+  std::function<void(double)> progress;
+};
+
+struct ReferenceStats {
+  int pixels = 0;
+  double bruteSeconds = 0;         // time brute force took on the sampled pixels
+  double bruteSecondsEstimate = 0; // extrapolated to the whole image
+  double testSeconds = 0;          // time the tested method took on the same pixels
+  double meanRelativeError = 0;
+  double p99RelativeError = 0;
+  double maxRelativeError = 0;
+  double fractionOver2pct = 0;
+  double bruteLightsPerShadingPoint = 0;
+};
+
+struct RenderStats {
+  double seconds = 0;
+  uint64_t primaryRays = 0;
+  uint64_t secondaryRays = 0;  // reflection and refraction
+  lightcuts::EvalStats eval;
+  ReferenceStats reference;
+};
+
+struct RenderResult {
+  io::Image image;
+  std::vector<float> cutSize;  // per pixel: cut nodes summed over its shading points / spp
+  RenderStats stats;
+  bool interrupted = false;
+  std::vector<uint8_t> done;   // per pixel: 1 when rendered (an interrupted render is partial)
+};
+
+RenderResult render(const scene::Scene& scene, const lightcuts::LightEvaluator& evaluator,
+                    const RenderOptions& options);
+
+// Radiance along one camera ray (exposed for tests).
+Color traceRay(const scene::Scene& scene, const lightcuts::LightEvaluator& evaluator, const scene::Ray& ray,
+               int maxDepth, lightcuts::EvalStats& stats);
+
+}  // namespace lc::render

@@ -1,0 +1,101 @@
+// The renderable scene: world-space geometry in an Embree BVH, resolved materials and
+// textures, the camera and the light list. Built once from an io::SceneDesc; immutable
+// and thread-safe for queries afterwards (the light list can still be extended by the
+// object-light and VPL generators before rendering starts).
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/limits.h"
+#include "io/scene_desc.h"
+#include "scene/camera.h"
+#include "scene/light.h"
+#include "scene/material.h"
+#include "scene/shape.h"
+
+namespace lc::scene {
+
+struct Ray {
+  Vec3 o, d;  // d need not be unit length; t is in units of |d|
+  float tmin = 0, tmax = kInf;
+};
+
+// A ray-surface intersection with everything shading needs.
+struct Hit {
+  float t = kInf;
+  Vec3 p;        // world position
+  Vec3 ng;       // unit geometric normal, facing the incoming ray
+  Vec3 ns;       // unit shading normal, on the same side as ng
+  Vec2 uv;       // texture coordinates
+  bool frontFace = true;  // the ray hit the outside (the side the stored normal points to)
+  int shape = -1;         // index into Scene::shapes()
+  int prim = 0;           // triangle index for meshes
+  Vec3 bary;              // barycentrics (meshes)
+};
+
+struct BuildOptions {
+  Limits limits;
+  int threads = 0;  // 0 = all cores
+};
+
+class Scene {
+ public:
+  // Builds geometry, materials (textures loaded and shared) and the scene's own lights.
+  // Throws lc::Error on bad input (singular transforms, missing textures, limits).
+  static std::unique_ptr<Scene> build(const io::SceneDesc& desc, const BuildOptions& options = {});
+  ~Scene();
+  Scene(const Scene&) = delete;
+  Scene& operator=(const Scene&) = delete;
+
+  // Closest hit along the ray within [tmin, tmax].
+  bool intersect(const Ray& ray, Hit& hit) const;
+  // Fraction of light that reaches along the segment origin + t*dir, t in (0, tmax):
+  // 0 behind an opaque surface, the product of transmissive colours through glass.
+  Color transmittance(const Vec3& origin, const Vec3& dir, float tmax) const;
+  // Binary visibility, the fast path for scenes without transmissive materials.
+  bool occluded(const Vec3& origin, const Vec3& dir, float tmax) const;
+  bool hasTransmissive() const { return hasTransmissive_; }
+
+  // Material values at a hit (textures looked up, per-vertex materials blended).
+  ShadingMaterial shadingMaterial(const Hit& hit) const;
+
+  // A point slightly off the surface on the side `dir` points to, for secondary rays.
+  Vec3 offsetOrigin(const Hit& hit, const Vec3& dir) const;
+  float epsilon() const { return epsilon_; }
+
+  const Camera& camera() const { return camera_; }
+  void setCamera(const Camera& c) { camera_ = c; }
+  const std::vector<Shape>& shapes() const { return shapes_; }
+  const std::vector<Mesh>& meshes() const { return meshes_; }
+  const std::vector<Material>& materials() const { return materials_; }
+  const Material& materialOf(const Hit& hit) const;
+  const Bounds3& bounds() const { return bounds_; }
+  Color ambient() const { return ambient_; }
+  LightSet& lights() { return lights_; }
+  const LightSet& lights() const { return lights_; }
+  const io::SceneDesc& desc() const { return desc_; }
+  size_t triangleCount() const;
+
+ private:
+  Scene() = default;
+  void buildGeometry(const BuildOptions& options);
+
+  io::SceneDesc desc_;
+  Camera camera_;
+  std::vector<Material> materials_;
+  std::vector<Shape> shapes_;
+  std::vector<Mesh> meshes_;
+  LightSet lights_;
+  Color ambient_;
+  Bounds3 bounds_;
+  float epsilon_ = 1e-4f;
+  bool hasTransmissive_ = false;
+  RTCDevice device_ = nullptr;
+  RTCScene rtc_ = nullptr;
+};
+
+}  // namespace lc::scene

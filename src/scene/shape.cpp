@@ -1,0 +1,234 @@
+#include "scene/shape.h"
+
+#include <cmath>
+
+namespace lc::scene {
+
+namespace {
+
+using io::ShapeKind;
+
+// Keeps the smallest root in (tmin, tmax).
+struct Closest {
+  double tmin, tmax;
+  double t;
+  int part = -1;
+  Closest(double lo, double hi) : tmin(lo), tmax(hi), t(hi) {}
+  void offer(double tc, int p) {
+    if (tc > tmin && tc < t) {
+      t = tc;
+      part = p;
+    }
+  }
+};
+
+// Roots of a t^2 + b t + c = 0 in a numerically stable form; false if none.
+bool solveQuadratic(double a, double b, double c, double& t0, double& t1) {
+  if (a == 0) {
+    if (b == 0) return false;
+    t0 = t1 = -c / b;
+    return true;
+  }
+  double disc = b * b - 4 * a * c;
+  if (disc < 0) return false;
+  double s = std::sqrt(disc);
+  double q = b < 0 ? -0.5 * (b - s) : -0.5 * (b + s);
+  t0 = q / a;
+  t1 = q != 0 ? c / q : t0;
+  if (t0 > t1) std::swap(t0, t1);
+  return true;
+}
+
+// A disk of radius r in the plane z = z0.
+void offerDisk(Closest& c, const double o[3], const double d[3], double z0, double r, int part) {
+  if (d[2] == 0 || r <= 0) return;
+  double t = (z0 - o[2]) / d[2];
+  double x = o[0] + t * d[0], y = o[1] + t * d[1];
+  if (x * x + y * y <= r * r) c.offer(t, part);
+}
+
+}  // namespace
+
+bool intersectQuadric(const Shape& s, const Vec3& of, const Vec3& df, float tmin, float tmax,
+                      float& tOut, int& partOut) {
+  const double o[3] = {of.x, of.y, of.z};
+  const double d[3] = {df.x, df.y, df.z};
+  Closest c(tmin, tmax);
+  switch (s.kind) {
+    case ShapeKind::Sphere: {
+      double a = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+      double b = 2 * (o[0] * d[0] + o[1] * d[1] + o[2] * d[2]);
+      double cc = o[0] * o[0] + o[1] * o[1] + o[2] * o[2] - 1;
+      double t0, t1;
+      if (solveQuadratic(a, b, cc, t0, t1)) {
+        c.offer(t0, 0);
+        c.offer(t1, 0);
+      }
+      break;
+    }
+    case ShapeKind::Box: {
+      // Slabs: the entry face is the last axis to be entered, the exit face the first left.
+      double tNear = -INFINITY, tFar = INFINITY;
+      int nearPart = -1, farPart = -1;
+      for (int i = 0; i < 3; ++i) {
+        if (d[i] == 0) {
+          if (o[i] < -0.5 || o[i] > 0.5) return false;
+          continue;
+        }
+        double inv = 1.0 / d[i];
+        double ta = (-0.5 - o[i]) * inv, tb = (0.5 - o[i]) * inv;
+        int pa = 2 * i, pb = 2 * i + 1;  // -face, +face
+        if (ta > tb) {
+          std::swap(ta, tb);
+          std::swap(pa, pb);
+        }
+        if (ta > tNear) { tNear = ta; nearPart = pa; }
+        if (tb < tFar) { tFar = tb; farPart = pb; }
+      }
+      if (tNear > tFar) return false;
+      if (nearPart >= 0) c.offer(tNear, nearPart);
+      if (farPart >= 0) c.offer(tFar, farPart);
+      break;
+    }
+    case ShapeKind::Square: {
+      if (d[2] == 0) return false;
+      double t = -o[2] / d[2];
+      double x = o[0] + t * d[0], y = o[1] + t * d[1];
+      if (std::fabs(x) <= 0.5 && std::fabs(y) <= 0.5) c.offer(t, 0);
+      break;
+    }
+    case ShapeKind::Cylinder: {
+      double a = d[0] * d[0] + d[1] * d[1];
+      double b = 2 * (o[0] * d[0] + o[1] * d[1]);
+      double cc = o[0] * o[0] + o[1] * o[1] - 1;
+      double t0, t1;
+      if (a > 0 && solveQuadratic(a, b, cc, t0, t1)) {
+        for (double t : {t0, t1}) {
+          double z = o[2] + t * d[2];
+          if (z >= 0 && z <= 1) c.offer(t, 0);
+        }
+      }
+      if (s.capped) {
+        offerDisk(c, o, d, 0, 1, 1);
+        offerDisk(c, o, d, 1, 1, 2);
+      }
+      break;
+    }
+    case ShapeKind::Cone: {
+      double h = s.height, r0 = s.bottomRadius, r1 = s.topRadius;
+      if (h <= 0) return false;
+      double k = (r1 - r0) / h;
+      // x^2 + y^2 = (r0 + k z)^2
+      double rz0 = r0 + k * o[2];
+      double a = d[0] * d[0] + d[1] * d[1] - k * k * d[2] * d[2];
+      double b = 2 * (o[0] * d[0] + o[1] * d[1] - k * rz0 * d[2]);
+      double cc = o[0] * o[0] + o[1] * o[1] - rz0 * rz0;
+      double t0, t1;
+      if (solveQuadratic(a, b, cc, t0, t1)) {
+        for (double t : {t0, t1}) {
+          double z = o[2] + t * d[2];
+          // The quadric is a double cone: keep the nappe where the radius is non-negative.
+          if (z >= 0 && z <= h && r0 + k * z >= 0) c.offer(t, 0);
+        }
+      }
+      if (s.capped) {
+        offerDisk(c, o, d, 0, r0, 1);
+        offerDisk(c, o, d, h, r1, 2);
+      }
+      break;
+    }
+    case ShapeKind::Mesh:
+      return false;
+  }
+  if (c.part < 0) return false;
+  tOut = float(c.t);
+  partOut = c.part;
+  // Rounding to float must keep t inside the open interval the caller asked for.
+  return tOut > tmin && tOut < tmax;
+}
+
+Vec3 quadricLocalNormal(const Shape& s, const Vec3& p, int part) {
+  switch (s.kind) {
+    case ShapeKind::Sphere: return p;
+    case ShapeKind::Box: {
+      Vec3 n(0, 0, 0);
+      n[part / 2] = (part % 2) ? 1.0f : -1.0f;
+      return n;
+    }
+    case ShapeKind::Square: return Vec3(0, 0, 1);
+    case ShapeKind::Cylinder:
+      if (part == 1) return Vec3(0, 0, -1);
+      if (part == 2) return Vec3(0, 0, 1);
+      return Vec3(p.x, p.y, 0);
+    case ShapeKind::Cone: {
+      if (part == 1) return Vec3(0, 0, -1);
+      if (part == 2) return Vec3(0, 0, 1);
+      float k = (s.topRadius - s.bottomRadius) / s.height;
+      float r = s.bottomRadius + k * p.z;
+      // Gradient of x^2 + y^2 - (r0 + k z)^2.
+      return Vec3(p.x, p.y, -k * r);
+    }
+    case ShapeKind::Mesh: break;
+  }
+  return Vec3(0, 0, 1);
+}
+
+static float angleU(const Vec3& p) {
+  float u = std::atan2(p.y, p.x) / (2 * kPi);
+  return u < 0 ? u + 1 : u;
+}
+
+Vec2 quadricUv(const Shape& s, const Vec3& p, int part) {
+  switch (s.kind) {
+    case ShapeKind::Sphere: {
+      float z = std::clamp(p.z / std::max(length(p), 1e-20f), -1.0f, 1.0f);
+      return Vec2(angleU(p), 0.5f + std::asin(z) / kPi);
+    }
+    case ShapeKind::Box: {
+      int axis = part / 2;
+      int a = (axis + 1) % 3, b = (axis + 2) % 3;
+      if (axis == 1) std::swap(a, b);  // keep (u, v) right-handed about each face normal
+      return Vec2(p[a] + 0.5f, p[b] + 0.5f);
+    }
+    case ShapeKind::Square: return Vec2(p.x + 0.5f, p.y + 0.5f);
+    case ShapeKind::Cylinder:
+    case ShapeKind::Cone: {
+      float h = s.kind == ShapeKind::Cylinder ? 1.0f : s.height;
+      if (part == 0) return Vec2(angleU(p), p.z / h);
+      float r = s.kind == ShapeKind::Cylinder ? 1.0f : (part == 1 ? s.bottomRadius : s.topRadius);
+      if (r <= 0) r = 1;
+      return Vec2((p.x / r + 1) * 0.5f, (p.y / r + 1) * 0.5f);
+    }
+    case ShapeKind::Mesh: break;
+  }
+  return Vec2(0, 0);
+}
+
+Bounds3 quadricBounds(const Shape& s) {
+  Bounds3 local;
+  switch (s.kind) {
+    case ShapeKind::Sphere: local = Bounds3(Vec3(-1, -1, -1), Vec3(1, 1, 1)); break;
+    case ShapeKind::Box: local = Bounds3(Vec3(-0.5f), Vec3(0.5f)); break;
+    case ShapeKind::Square: local = Bounds3(Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, 0.5f, 0)); break;
+    case ShapeKind::Cylinder: local = Bounds3(Vec3(-1, -1, 0), Vec3(1, 1, 1)); break;
+    case ShapeKind::Cone: {
+      float r = std::max(std::fabs(s.bottomRadius), std::fabs(s.topRadius));
+      local = Bounds3(Vec3(-r, -r, 0), Vec3(r, r, s.height));
+      break;
+    }
+    case ShapeKind::Mesh: return {};
+  }
+  Bounds3 world;
+  for (int i = 0; i < 8; ++i) {
+    Vec3 c((i & 1) ? local.hi.x : local.lo.x, (i & 2) ? local.hi.y : local.lo.y,
+           (i & 4) ? local.hi.z : local.lo.z);
+    world.extend(s.toWorld.point(c));
+  }
+  // Pad for float rounding in the transform so Embree never culls a true hit.
+  Vec3 pad = (vabs(world.lo) + vabs(world.hi) + world.extent()) * 1e-6f;
+  world.lo -= pad;
+  world.hi += pad;
+  return world;
+}
+
+}  // namespace lc::scene

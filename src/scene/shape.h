@@ -1,0 +1,58 @@
+// Geometry: analytic quadrics in their canonical frame under an affine transform, and
+// triangle meshes stored in world space.
+//
+// Canonical shapes (local frame):
+//   sphere    radius 1 at the origin
+//   box       the cube [-0.5, 0.5]^3
+//   square    [-0.5, 0.5]^2 in the plane z = 0, normal +z
+//   cylinder  radius 1 about z, z in [0, 1]; caps at z = 0 and z = 1 when capped
+//   cone      along +z, radius bottomRadius at z = 0 to topRadius at z = height; caps when capped
+// Texture coordinates (documented in docs/SCENE_FORMAT.md):
+//   sphere    u = longitude/(2 pi) about z from +x, v = 0.5 + latitude/pi (0 at z = -1)
+//   box       per face, the face's two in-plane coordinates + 0.5
+//   square    (x + 0.5, y + 0.5)
+//   cylinder/cone body u = angle/(2 pi), v = z/height; caps ((x/r + 1)/2, (y/r + 1)/2)
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+#include "io/scene_desc.h"
+
+namespace lc::scene {
+
+struct Mesh {
+  std::vector<Vec3> positions;  // world space
+  std::vector<Vec3> normals;    // world space, unit; empty = flat shading
+  std::vector<Vec2> uvs;        // empty = none
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<int> triangleMaterials;  // empty = the shape's material
+  std::vector<int> vertexMaterials;    // empty = none; else blended barycentrically
+};
+
+struct Shape {
+  io::ShapeKind kind = io::ShapeKind::Sphere;
+  Mat4 toWorld = Mat4::identity();
+  Mat4 toLocal = Mat4::identity();
+  int material = 0;
+  int mesh = -1;  // meshes only
+  bool capped = true;
+  float height = 1, bottomRadius = 1, topRadius = 0;
+  Bounds3 bounds;  // world space
+  std::string name;
+  SourceLoc loc;
+};
+
+// Intersection of a local-space ray with a canonical quadric: the smallest t in
+// (tmin, tmax), or false. `part` identifies the face/cap hit (for normals and uvs).
+bool intersectQuadric(const Shape& s, const Vec3& o, const Vec3& d, float tmin, float tmax,
+                      float& t, int& part);
+// Local-space normal (not normalised) and uv of a local point on a quadric's `part`.
+Vec3 quadricLocalNormal(const Shape& s, const Vec3& p, int part);
+Vec2 quadricUv(const Shape& s, const Vec3& p, int part);
+// World bounds of a quadric (its local bounding box, transformed).
+Bounds3 quadricBounds(const Shape& s);
+
+}  // namespace lc::scene
