@@ -1,0 +1,203 @@
+// Closed-form shading, mirrors, invisible panes and thread-count independence.
+#include "render/renderer.h"
+
+#include <gtest/gtest.h>
+
+#include "io/ray_parser.h"
+
+namespace lc::render {
+namespace {
+
+std::unique_ptr<scene::Scene> sceneFrom(const std::string& text) {
+  io::SceneDesc d = io::parseRayString(text, "test.ray", "");
+  return scene::Scene::build(d);
+}
+
+RenderResult renderBrute(const scene::Scene& s, int w, int h, int threads = 0, int spp = 1) {
+  auto ev = lightcuts::makeBruteForce(s.lights());
+  RenderOptions o;
+  o.width = w;
+  o.height = h;
+  o.threads = threads;
+  o.spp = spp;
+  return render(s, *ev, o);
+}
+
+// The Phong model of the course renderer, evaluated by hand for a point on the plane z=0.
+Color phongOnPlane(Vec3 p, Vec3 eye, Vec3 lightPos, Color lightColour, float a, float b, float c, Color kd,
+                   Color ks, float shininess) {
+  Vec3 N(0, 0, 1);
+  Vec3 L = lightPos - p;
+  float d = length(L);
+  L = L / d;
+  Vec3 V = normalize(eye - p);
+  Vec3 R = normalize(N * (2 * dot(N, L)) - L);
+  float atten = std::min(1.0f, 1.0f / (a + b * d + c * d * d));
+  Color spec = ks * std::pow(std::max(0.0f, dot(R, V)), shininess);
+  return (kd * std::max(0.0f, dot(N, L)) + spec) * atten * lightColour;
+}
+
+const char* kPlaneScene = R"(SBT-raytracer 1.0
+camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 60; }
+point_light { position = (1, 1.5, 2); colour = (1, 0.9, 0.8);
+  constant_attenuation_coeff = 0.1; linear_attenuation_coeff = 0.2; quadratic_attenuation_coeff = 0.05; }
+scale(10, square { material = { diffuse = (0.5, 0.6, 0.7); specular = (0.3, 0.3, 0.3); shininess = 10; }; })
+)";
+
+TEST(Shading, OnePointLightOverADiffuseSquareMatchesPhong) {
+  auto s = sceneFrom(kPlaneScene);
+  const int W = 15, H = 15;
+  RenderResult r = renderBrute(*s, W, H);
+  const scene::Camera& cam = s->camera();
+  int checked = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      Vec3 d = normalize(cam.direction((float(x) + 0.5f) / W, (float(y) + 0.5f) / H));
+      float t = -cam.eye.z / d.z;
+      Vec3 p = cam.eye + d * t;
+      if (std::fabs(p.x) > 5 || std::fabs(p.y) > 5) continue;
+      Color expect = phongOnPlane(p, cam.eye, Vec3(1, 1.5f, 2), Color(1, 0.9f, 0.8f), 0.1f, 0.2f, 0.05f,
+                                  Color(0.5f, 0.6f, 0.7f), Color(0.3f), 10);
+      const Color& got = r.image.at(x, y);
+      for (int c = 0; c < 3; ++c) ASSERT_NEAR(got[c], expect[c], 1e-4f) << x << "," << y;
+      ++checked;
+    }
+  EXPECT_GT(checked, 100);
+}
+
+TEST(Shading, SpotFalloffIsCosinePowerWithCutoff) {
+  auto s = sceneFrom(R"(SBT-raytracer 1.0
+camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 90; }
+spot_light { position = (0, 0, 2); direction = (0, 0, -1); colour = (1, 1, 1); exponent = 4; cutoff = 30;
+  constant_attenuation_coeff = 1; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 0; }
+scale(20, square { material = { diffuse = (1, 1, 1); }; })
+)");
+  const int W = 41, H = 41;
+  RenderResult r = renderBrute(*s, W, H);
+  const scene::Camera& cam = s->camera();
+  int lit = 0, dark = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      Vec3 d = normalize(cam.direction((float(x) + 0.5f) / W, (float(y) + 0.5f) / H));
+      Vec3 p = cam.eye + d * (-cam.eye.z / d.z);
+      Vec3 toP = normalize(p - Vec3(0, 0, 2));
+      float cosA = dot(toP, Vec3(0, 0, -1));
+      float cosN = dot(Vec3(0, 0, 1), -toP);
+      float expect = cosA > std::cos(30 * kPi / 180) ? std::pow(cosA, 4.0f) * cosN : 0.0f;
+      if (std::fabs(cosA - std::cos(30 * kPi / 180)) < 1e-3f) continue;  // exactly on the cutoff
+      ASSERT_NEAR(r.image.at(x, y).x, expect, 1e-4f) << x << "," << y;
+      (expect > 0 ? lit : dark)++;
+    }
+  EXPECT_GT(lit, 50);
+  EXPECT_GT(dark, 50);
+}
+
+TEST(Shading, AttenuationFollowsTheCourseFormula) {
+  // Directly below a light at height h: atten = min(1, 1/(a + b h + c h^2)) times kd.
+  auto s = sceneFrom(R"(SBT-raytracer 1.0
+camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 10; }
+point_light { position = (0, 0, 3); colour = (1, 1, 1);
+  constant_attenuation_coeff = 0.2; linear_attenuation_coeff = 0.3; quadratic_attenuation_coeff = 0.0; }
+scale(10, square { material = { diffuse = (0, 1, 0); }; })
+)");
+  RenderResult r = renderBrute(*s, 1, 1);
+  EXPECT_NEAR(r.image.at(0, 0).y, 1.0f / (0.2f + 0.3f * 3), 1e-4f);
+}
+
+TEST(Shading, ShadowsThroughGlassAreAttenuatedByItsColour) {
+  // A tiny pane (index 1) between the camera, a point light straight above a white plane,
+  // and the plane: the camera sees the plane through the pane, lit through the pane.
+  auto a = sceneFrom(R"(SBT-raytracer 1.0
+camera { position = (0.02, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 0.01; }
+point_light { position = (0.02, 0, 4); colour = (1, 1, 1);
+  constant_attenuation_coeff = 1; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 0; }
+scale(10, square { material = { diffuse = (1, 1, 1); }; })
+translate(0.02, 0, 2, scale(0.01, square { material = { transmissive = (0.5, 0.25, 1); index = 1; }; }))
+)");
+  RenderResult r = renderBrute(*a, 1, 1, 0);
+  // The pane is also seen by the camera: refracted straight through (index 1), then the
+  // plane is lit through the pane: kt * (kd * light * kt).
+  EXPECT_NEAR(r.image.at(0, 0).x, 0.5f * 0.5f, 1e-4f);
+  EXPECT_NEAR(r.image.at(0, 0).y, 0.25f * 0.25f, 1e-4f);
+  EXPECT_NEAR(r.image.at(0, 0).z, 1.0f, 1e-4f);
+}
+
+TEST(Whitted, MirrorReproducesTheReflectedScene) {
+  const char* objects = R"(
+translate(0.5, 0.3, %s, sphere { material = { emissive = (1, 0.2, 0.1); }; })
+translate(-0.8, -0.4, %s, scale(0.8, box { material = { emissive = (0.1, 0.9, 0.3); }; }))
+)";
+  char withMirror[1024], reflected[1024];
+  std::snprintf(withMirror, sizeof withMirror, objects, "6.5", "6.8");
+  std::snprintf(reflected, sizeof reflected, objects, "-6.5", "-6.8");
+  std::string cam = R"(SBT-raytracer 1.0
+camera { position = (0, 0, 4); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 40; }
+)";
+  auto a = sceneFrom(cam + "scale(20, square { material = { reflective = (1, 1, 1); }; })\n" + withMirror);
+  auto b = sceneFrom(cam + reflected);
+  RenderResult ra = renderBrute(*a, 48, 48), rb = renderBrute(*b, 48, 48);
+  int same = 0, lit = 0;
+  for (size_t i = 0; i < ra.image.pixels.size(); ++i) {
+    same += length(ra.image.pixels[i] - rb.image.pixels[i]) < 1e-5f;
+    lit += !isBlack(rb.image.pixels[i]);
+  }
+  EXPECT_GT(lit, 100);
+  EXPECT_GE(same, int(ra.image.pixels.size()) - 8);  // a few edge pixels may round differently
+}
+
+TEST(Whitted, PaneOfIndexOneIsInvisible) {
+  std::string scene = R"(SBT-raytracer 1.0
+camera { position = (0, 0, 6); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 40; }
+translate(0, 0, -3, scale(12, square { material = { emissive = (0.3, 0.5, 0.7); }; }))
+translate(0.4, 0.2, -1, sphere { material = { emissive = (0.9, 0.6, 0.1); }; })
+)";
+  std::string pane = "translate(0, 0, 2, scale(3, 3, 0.2, box { material = { transmissive = (1, 1, 1); index = 1; }; }))\n";
+  auto a = sceneFrom(scene), b = sceneFrom(scene + pane);
+  RenderResult ra = renderBrute(*a, 48, 48), rb = renderBrute(*b, 48, 48);
+  int same = 0;
+  for (size_t i = 0; i < ra.image.pixels.size(); ++i) same += length(ra.image.pixels[i] - rb.image.pixels[i]) < 1e-5f;
+  EXPECT_GE(same, int(ra.image.pixels.size()) - 8);
+}
+
+TEST(Whitted, GlassSphereRefractsAndTotalInternalReflectionKeepsEnergyFinite) {
+  auto s = sceneFrom(R"(SBT-raytracer 1.0
+camera { position = (0, 0, 6); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 40; }
+translate(0, 0, -3, scale(12, square { material = { emissive = (0.3, 0.5, 0.7); }; }))
+sphere { material = { transmissive = (0.9, 0.9, 0.9); reflective = (0.1, 0.1, 0.1); index = 1.5; }; }
+)");
+  RenderResult r = renderBrute(*s, 32, 32);
+  for (const Color& c : r.image.pixels) {
+    ASSERT_TRUE(isFinite(c));
+    ASSERT_LE(maxComponent(c), 1.0f);
+  }
+  // The centre sees the background through the sphere, dimmed by kt twice.
+  EXPECT_NEAR(r.image.at(16, 16).z, 0.7f * 0.81f, 0.02f);
+}
+
+TEST(Determinism, SameImageAtOneAndTwoThreads) {
+  auto s = sceneFrom(R"(SBT-raytracer 1.0
+camera { position = (0, 1, 6); viewdir = (0, -0.2, -1); updir = (0, 1, 0); }
+point_light { position = (2, 3, 2); colour = (1, 1, 1); constant_attenuation_coeff = 1; quadratic_attenuation_coeff = 0; }
+point_light { position = (-2, 2, 3); colour = (0.5, 0.6, 1); constant_attenuation_coeff = 1; quadratic_attenuation_coeff = 0; }
+scale(10, rotate(1, 0, 0, -1.5707963, square { material = { diffuse = (0.8, 0.8, 0.8); reflective = (0.2, 0.2, 0.2); }; }))
+translate(0, 0.5, 0, sphere { material = { diffuse = (0.7, 0.2, 0.2); specular = (0.5, 0.5, 0.5); shininess = 30; }; })
+)");
+  RenderResult a = renderBrute(*s, 40, 30, 1, 4), b = renderBrute(*s, 40, 30, 2, 4);
+  ASSERT_EQ(a.image.pixels.size(), b.image.pixels.size());
+  for (size_t i = 0; i < a.image.pixels.size(); ++i) ASSERT_EQ(a.image.pixels[i], b.image.pixels[i]) << i;
+}
+
+TEST(Renderer, CancelledRenderIsMarkedInterrupted) {
+  auto s = sceneFrom(kPlaneScene);
+  auto ev = lightcuts::makeBruteForce(s->lights());
+  std::atomic<bool> cancel{true};
+  RenderOptions o;
+  o.width = 64;
+  o.height = 64;
+  o.cancel = &cancel;
+  RenderResult r = render(*s, *ev, o);
+  EXPECT_TRUE(r.interrupted);
+}
+
+}  // namespace
+}  // namespace lc::render
