@@ -194,7 +194,15 @@ struct ObjScan {
 const char* const kIndexWhat[3] = {"vertex", "texture coordinate", "normal"};
 const char* const kIndexLine[3] = {"v", "vt", "vn"};
 
-ObjScan scanObj(const std::string& text, const std::string& path, const Limits& limits) {
+// A limit error: at the obj_mesh that named the file when there is one (the place to look
+// in the .ray file), else without a location.
+[[noreturn]] void throwLimit(const SourceLoc& referredFrom, const std::string& msg) {
+  if (referredFrom.line > 0) throw Error(referredFrom, msg);
+  throw Error(msg);
+}
+
+ObjScan scanObj(const std::string& text, const std::string& path, const Limits& limits,
+                const SourceLoc& referredFrom) {
   ObjScan scan;
   // Largest positive index seen per kind and its line: positive indices may refer
   // forward (tinyobj allows it), so they are checked against the final counts.
@@ -287,11 +295,11 @@ ObjScan scanObj(const std::string& text, const std::string& path, const Limits& 
                       " '" + kIndexLine[k] + "' lines");
 
   if (scan.triangles > limits.maxTriangles)
-    throw Error("OBJ file '" + path + "' has " + std::to_string(scan.triangles) +
+    throwLimit(referredFrom, "OBJ file '" + path + "' has " + std::to_string(scan.triangles) +
                 " triangles, more than the limit of " + std::to_string(limits.maxTriangles) +
                 " (raise it with --max-triangles)");
   if (scan.positions > limits.maxVertices)
-    throw Error("OBJ file '" + path + "' has " + std::to_string(scan.positions) +
+    throwLimit(referredFrom, "OBJ file '" + path + "' has " + std::to_string(scan.positions) +
                 " vertices, more than the limit of " + std::to_string(limits.maxVertices) +
                 " (raise it with --max-triangles)");
   return scan;
@@ -570,7 +578,7 @@ ObjData loadObj(const std::string& path, const SourceLoc& referredFrom, const Ma
                 const Limits& limits) {
   openCheck(path, referredFrom, limits);
   std::string text = readFile(path);
-  ObjScan scan = scanObj(text, path, limits);
+  ObjScan scan = scanObj(text, path, limits, referredFrom);
 
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
@@ -634,7 +642,7 @@ ObjData loadObj(const std::string& path, const SourceLoc& referredFrom, const Ma
     triCount += mesh.num_face_vertices.size();
   }
   if (triCount > limits.maxTriangles)
-    throw Error("OBJ file '" + path + "' has " + std::to_string(triCount) +
+    throwLimit(referredFrom, "OBJ file '" + path + "' has " + std::to_string(triCount) +
                 " triangles, more than the limit of " + std::to_string(limits.maxTriangles) +
                 " (raise it with --max-triangles)");
 
@@ -679,9 +687,9 @@ ObjData loadObj(const std::string& path, const SourceLoc& referredFrom, const Ma
         auto [it, inserted] = vertexOf.try_emplace(key, int(mesh.points.size()));
         if (inserted) {
           if (mesh.points.size() >= limits.maxVertices)
-            throw Error("OBJ file '" + path + "' has more than " +
+            throwLimit(referredFrom, "OBJ file '" + path + "' has more than " +
                         std::to_string(limits.maxVertices) +
-                        " distinct vertices (raise the limit with --max-triangles)");
+                        " distinct vertices (raise it with --max-triangles)");
           const size_t v = size_t(key.v);
           Vec3 p(float(attrib.vertices[3 * v]), float(attrib.vertices[3 * v + 1]),
                  float(attrib.vertices[3 * v + 2]));

@@ -1075,8 +1075,12 @@ void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
         Token open = lex_.peek();
         list([&] {
           Token t = numberToken();
-          if (std::floor(t.number) != t.number || std::fabs(t.number) > 2147483647.0)
-            fail(t, "face index " + t.text + " is not an integer");
+          if (std::floor(t.number) != t.number) fail(t, "face index " + t.text + " is not an integer");
+          if (std::fabs(t.number) > 2147483647.0)
+            fail(t, "face index " + t.text + " is out of range (" +
+                        (pointsDone ? "the mesh has " + std::to_string(mesh.points.size()) + " points"
+                                    : std::string("indices are at most 2147483647")) +
+                        ")");
           long long idx = (long long)t.number;
           if (pointsDone && (idx < 0 || idx >= (long long)mesh.points.size()))
             outOfRange(idx, t.line, t.column);
