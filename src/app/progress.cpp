@@ -16,7 +16,8 @@ ProgressBar::ProgressBar(std::string label, bool quiet)
 void ProgressBar::update(double f) {
   if (quiet_) return;
   double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  if (el < 1.0 && f < 1.0) return;
+  // Short renders print nothing; the final update only closes a bar that was shown.
+  if (el < 1.0 && !shown_) return;
   shown_ = true;
   f = std::clamp(f, 0.0, 1.0);
   std::string eta = f > 0.01 ? formatSeconds(el * (1 - f) / f) : "?";

@@ -37,6 +37,7 @@ struct RenderArgs {
   std::string tree;  // default: by method
   float error = -1;  // default: by method
   int maxCut = 1000;
+  std::string criterion = "total";
   std::string cutHeatmap;
   int referencePixels = 0;
   std::string tonemap = "clamp";
@@ -107,7 +108,7 @@ int runRender(RenderArgs& a) {
   // Light tree and evaluator.
   lightcuts::LightForest forest;
   std::unique_ptr<lightcuts::LightEvaluator> evaluator;
-  lightcuts::CutOptions co{error, a.maxCut};
+  lightcuts::CutOptions co{error, a.maxCut, lightcuts::parseCutCriterion(a.criterion)};
   if (method == lightcuts::Method::Brute) {
     evaluator = lightcuts::makeBruteForce(scene.lights());
   } else {
@@ -149,6 +150,7 @@ int runRender(RenderArgs& a) {
     io::Image hm = io::heatmap(rr.cutSize, a.width, a.height, 0, maxCut, "lights per pixel (cut size)");
     io::writeImage(a.cutHeatmap, hm);
   }
+  double clampedFraction = ls.vpls.vpls ? render::vplClampedFraction(scene, ro) : 0;
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   const auto& es = rr.stats.eval;
@@ -168,6 +170,7 @@ int runRender(RenderArgs& a) {
     j["method"] = lightcuts::methodName(method);
     j["error_threshold"] = error;
     j["max_cut"] = a.maxCut;
+    j["cut_criterion"] = a.criterion;
     j["max_depth"] = a.maxDepth;
     j["time_total_s"] = total;
     j["time_load_s"] = ls.loadSeconds;
@@ -204,6 +207,7 @@ int runRender(RenderArgs& a) {
     j["object_lights"] = objs;
     j["vpls"] = {{"paths", ls.vpls.paths}, {"count", ls.vpls.vpls}, {"time_s", ls.vpls.seconds},
                  {"clamp_distance", ls.vpls.clampDistance}};
+    j["vpl_clamped_fraction"] = clampedFraction;
     if (ref.pixels > 0) {
       j["reference"] = {{"pixels", ref.pixels},
                         {"brute_seconds", ref.bruteSeconds},
@@ -233,13 +237,16 @@ int runRender(RenderArgs& a) {
       if (size_t c = L.countOf(LightType(t))) kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", c, lightTypeName(LightType(t)));
     fmt::print("scene      {} ({} objects, {} triangles)\n", a.scene, scene.shapes().size(), scene.triangleCount());
     fmt::print("lights     {}{}\n", L.size(), kinds.empty() ? "" : " (" + kinds + ")");
-    if (ls.vpls.vpls) fmt::print("vpls       {} from {} paths in {}\n", ls.vpls.vpls, ls.vpls.paths, formatSeconds(ls.vpls.seconds));
+    if (ls.vpls.vpls)
+      fmt::print("vpls       {} from {} paths in {}; clamp at {:.4g} removes {:.1f}% of their light\n", ls.vpls.vpls,
+                 ls.vpls.paths, formatSeconds(ls.vpls.seconds), ls.vpls.clampDistance, 100 * clampedFraction);
     if (method == lightcuts::Method::Brute)
       fmt::print("method     brute force\n");
     else
-      fmt::print("method     {} (tree {}: {} nodes, {:.1f} MiB, built in {}), error {}, max cut {}\n",
+      fmt::print("method     {} (tree {}: {} nodes, {:.1f} MiB, built in {}), error {}{}, max cut {}\n",
                  lightcuts::methodName(method), lightcuts::treeBuilderName(tb.builder), forest.nodeCount(),
-                 double(forest.memoryBytes()) / (1 << 20), formatSeconds(forest.buildSeconds), error, a.maxCut);
+                 double(forest.memoryBytes()) / (1 << 20), formatSeconds(forest.buildSeconds), error,
+                 method == lightcuts::Method::Lightcuts ? " (" + a.criterion + " criterion)" : "", a.maxCut);
     fmt::print("image      {}x{}, {} spp -> {}\n", a.width, a.height, a.spp, a.out);
     fmt::print("time       {} total: load {}, accel {}, lights {}, tree {}, render {}\n", formatSeconds(total),
                formatSeconds(ls.loadSeconds), formatSeconds(ls.accelSeconds), formatSeconds(ls.lightSeconds),
@@ -283,6 +290,10 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--error", a->error, "Error threshold: relative bound for lightcuts (default 0.02); radius/distance for seed (default 0.5)")
       ->check(CLI::Range(0.0, 1e6));
   c->add_option("--max-cut", a->maxCut, "Most nodes in one cut")->check(CLI::Range(1, 1 << 30));
+  c->add_option("--cut-criterion", a->criterion,
+                "When a lightcut stops: total (every bound and their root-sum-square below error x estimate, default) "
+                "or walter (every bound below error x estimate, as published)")
+      ->check(CLI::IsMember({"total", "walter"}));
   c->add_option("--cut-heatmap", a->cutHeatmap, "Write the per-pixel cut size, colour-mapped with a legend, to this PNG");
   c->add_option("--reference-pixels", a->referencePixels,
                 "Also run brute force at K pixels: report the measured error and the estimated brute-force time")

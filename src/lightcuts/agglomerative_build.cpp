@@ -556,7 +556,7 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
     // Bottom-up in chunks, each reduced to its survivors; chunks are as large as it takes
     // to leave at most half of exactLimit clusters for the exact top levels.
     size_t chunk = exactLimit;
-    while ((n + chunk - 1) / chunk * ApproximateClustering::survivors(chunk) > exactLimit / 2) chunk *= 2;
+    while (chunk < n && (n + chunk - 1) / chunk * ApproximateClustering::survivors(chunk) > exactLimit / 2) chunk *= 2;
     size_t chunks = (n + chunk - 1) / chunk;
     std::vector<std::vector<int32_t>> survivors(chunks);
     std::vector<int32_t> idBase(chunks);

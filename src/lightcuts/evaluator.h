@@ -24,9 +24,21 @@ enum class Method { Brute, Lightcuts, Seed };
 Method parseMethod(const std::string& name);  // "brute" | "lightcuts" | "seed"
 const char* methodName(Method m);
 
+// When a cut is good enough.
+//   Walter: every node's error bound is below errorRatio times the total estimate (Walter
+//     et al. 2005). The errors of many nodes near the threshold add up, so the total
+//     error is often a few times errorRatio.
+//   Total: the same, and also the root-sum-square of the bounds is below 2 x errorRatio
+//     times the estimate: the cut's errors are of random sign and well below their
+//     bounds, so this keeps the total error, not just each node's, under errorRatio.
+enum class CutCriterion { Walter, Total };
+CutCriterion parseCutCriterion(const std::string& name);  // "walter" | "total"
+const char* cutCriterionName(CutCriterion c);
+
 struct CutOptions {
   float errorRatio = 0.02f;  // --error: relative error threshold
   int maxCut = 1000;         // --max-cut: most nodes in one cut
+  CutCriterion criterion = CutCriterion::Total;
 };
 
 // Counters summed over shading points (per thread, then merged).

@@ -146,6 +146,53 @@ std::vector<std::pair<int, int>> referencePixelSet(int k, int w, int h) {
 
 }  // namespace
 
+double vplClampedFraction(const Scene& scene, const RenderOptions& o, int points, uint64_t maxEvaluations) {
+  const LightSet& ls = scene.lights();
+  std::vector<uint32_t> vpls;
+  for (uint32_t i = 0; i < ls.lights.size(); ++i)
+    if (ls.groups[ls.lights[i].group].isVpl) vpls.push_back(i);
+  if (vpls.empty()) return 0;
+  int k = int(std::clamp<uint64_t>(maxEvaluations / vpls.size(), 16, uint64_t(points)));
+  auto px = referencePixelSet(k, o.width, o.height);
+  std::vector<double> clamped(px.size(), 0), unclamped(px.size(), 0);
+  tbb::parallel_for(size_t(0), px.size(), [&](size_t i) {
+    const scene::Camera& cam = scene.camera();
+    Vec3 d = normalize(cam.direction((float(px[i].first) + 0.5f) / float(o.width),
+                                     (float(px[i].second) + 0.5f) / float(o.height)));
+    Hit h;
+    if (!scene.intersect(Ray{cam.eye, d, 0, kInf}, h)) return;
+    scene::ShadingMaterial m = scene.shadingMaterial(h);
+    if (isBlack(m.kd)) return;
+    ShadingPoint sp;
+    sp.p = h.p;
+    sp.n = h.ns;
+    sp.r = normalize(reflect(-d, h.ns));
+    sp.kd = m.kd;
+    ShadowRays vis(scene, h);
+    for (uint32_t li : vpls) {
+      const Light& l = ls.lights[li];
+      const LightGroup& g = ls.groups[l.group];
+      Color mg;
+      Vec3 wi;
+      float dist;
+      if (!lightcuts::lightContribution(l, g, sp, mg, wi, dist)) continue;
+      Color v = vis(wi, dist);
+      if (isBlack(v)) continue;
+      double c = luminance(mg * v * l.intensity);
+      // The clamp is min(1, 1/(q d^2)); without it the attenuation would be 1/(q d^2).
+      double free = g.atten.quadratic > 0 ? c / g.atten(dist) / (double(g.atten.quadratic) * dist * dist) : c;
+      clamped[i] += c;
+      unclamped[i] += free;
+    }
+  });
+  double a = 0, b = 0;
+  for (size_t i = 0; i < px.size(); ++i) {
+    a += clamped[i];
+    b += unclamped[i];
+  }
+  return b > 0 ? 1 - a / b : 0;
+}
+
 Color traceRay(const Scene& scene, const LightEvaluator& evaluator, const Ray& ray, int maxDepth,
                EvalStats& stats) {
   Tracer tr{scene, evaluator, maxDepth, stats};

@@ -63,6 +63,13 @@ struct RenderResult {
 RenderResult render(const scene::Scene& scene, const lightcuts::LightEvaluator& evaluator,
                     const RenderOptions& options);
 
+// Fraction of the VPLs' direct contribution that their distance clamp removes, measured
+// exactly (with visibility) at primary hits of up to `points` pixels spread over the image,
+// fewer when the scene has so many VPLs that points x VPLs would exceed `maxEvaluations`.
+// 0 when the scene has no VPLs.
+double vplClampedFraction(const scene::Scene& scene, const RenderOptions& options, int points = 256,
+                          uint64_t maxEvaluations = 20'000'000);
+
 // Radiance along one camera ray (exposed for tests).
 Color traceRay(const scene::Scene& scene, const lightcuts::LightEvaluator& evaluator, const scene::Ray& ray,
                int maxDepth, lightcuts::EvalStats& stats);

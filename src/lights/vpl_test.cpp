@@ -1,0 +1,150 @@
+#include "lights/vpl.h"
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "io/ray_parser.h"
+#include "lightcuts/bounds.h"
+#include "lightcuts/light_tree.h"
+
+namespace lc::lights {
+namespace {
+
+// A closed box of albedo `a`, 20 units wide (every wall farther than 1 from the light, so
+// min(1, 1/d^2) is exactly 1/d^2), with one point light of intensity I at its centre.
+std::unique_ptr<scene::Scene> closedBox(float a, float I) {
+  std::string text = fmt::format(R"(SBT-raytracer 1.0
+point_light {{ position = (0.3, -0.2, 0.1); colour = ({}, {}, {}); }}
+scale(20, box {{ material = {{ diffuse = ({}, {}, {}); }}; }})
+)", I, I, I, a, a, a);
+  return scene::Scene::build(io::parseRayString(text, "box.ray", ""));
+}
+
+TEST(Vpl, OneBounceCarriesAlbedoTimesEmittedPower) {
+  auto s = closedBox(0.5f, 2.0f);
+  VplOptions o;
+  o.count = 20000;
+  VplInfo info = addVpls(*s, o);
+  EXPECT_EQ(info.paths, 20000u);
+  EXPECT_EQ(info.vpls, 20000u);  // every path hits a wall
+  EXPECT_EQ(s->lights().size(), 20001u);
+  double emitted = 4 * kPi * 2.0;
+  EXPECT_NEAR(info.power.x / (0.5 * emitted), 1.0, 0.02);
+  // The VPL intensities sum to the reflected power / pi (before the clamp's rescaling).
+  const LightGroup& g = s->lights().groups[s->lights().lights.back().group];
+  EXPECT_TRUE(g.isVpl);
+  EXPECT_TRUE(g.diffuseOnly);
+}
+
+TEST(Vpl, BouncesFollowTheGeometricSeries) {
+  auto s = closedBox(0.6f, 1.0f);
+  VplOptions o;
+  o.count = 40000;
+  o.bounces = 3;
+  VplInfo info = addVpls(*s, o);
+  double emitted = 4 * kPi;
+  double expect = emitted * (0.6 + 0.36 + 0.216);
+  EXPECT_NEAR(info.power.y / expect, 1.0, 0.02);
+  EXPECT_GT(info.vpls, 40000u);
+}
+
+TEST(Vpl, SameSeedSameVpls) {
+  auto a = closedBox(0.5f, 1.0f), b = closedBox(0.5f, 1.0f);
+  VplOptions o;
+  o.count = 3000;
+  o.bounces = 2;
+  addVpls(*a, o);
+  addVpls(*b, o);
+  ASSERT_EQ(a->lights().size(), b->lights().size());
+  for (size_t i = 0; i < a->lights().size(); ++i) {
+    ASSERT_EQ(a->lights().lights[i].position, b->lights().lights[i].position);
+    ASSERT_EQ(a->lights().lights[i].intensity, b->lights().lights[i].intensity);
+  }
+}
+
+TEST(Vpl, ClampIsTheAttenuationOfEveryMethod) {
+  auto s = closedBox(0.5f, 1.0f);
+  VplOptions o;
+  o.count = 100;
+  o.clamp = 0.1f;
+  VplInfo info = addVpls(*s, o);
+  float dc = 0.1f * s->bounds().diagonal() / 2;
+  EXPECT_NEAR(info.clampDistance, dc, 1e-4f);
+  const Light& v = s->lights().lights.back();
+  const LightGroup& g = s->lights().groups[v.group];
+  // Intensity times attenuation is I * min(1/dc^2, 1/d^2) for the unscaled intensity I.
+  float I = v.intensity.x * dc * dc;
+  for (float d : {0.1f * dc, 0.5f * dc, dc, 2 * dc, 10 * dc})
+    EXPECT_NEAR(v.intensity.x * g.atten(d), I * std::min(1 / (dc * dc), 1 / (d * d)), 1e-5f * I / (dc * dc));
+  // The Lightcuts bound of a one-VPL cluster uses the same attenuation: it is >= the exact value.
+  lightcuts::LightNode node{};
+  node.lo = node.hi = v.position;
+  node.axis = v.direction;
+  node.cosHalfAngle = 1;
+  node.intensity = v.intensity;
+  lightcuts::ShadingPoint sp;
+  sp.p = v.position + v.direction * (0.3f * dc) + Vec3(0.01f, 0.02f, 0.0f);
+  sp.n = -v.direction;
+  sp.r = sp.n;
+  sp.kd = Color(1);
+  Color mg;
+  Vec3 wi;
+  float dist;
+  ASSERT_TRUE(lightcuts::lightContribution(v, g, sp, mg, wi, dist));
+  Color exact = mg * v.intensity;
+  Color bound = lightcuts::clusterBound(node, LightType::Oriented, g, sp, lightcuts::BoundFrames(sp));
+  EXPECT_GE(bound.x, exact.x);
+  EXPECT_LE(bound.x, exact.x * 1.01f);  // and tight for one light
+}
+
+TEST(Vpl, SeedNormalisationDividesByVplsOnTheObject) {
+  auto s = closedBox(0.5f, 2.0f);
+  VplOptions o;
+  o.count = 500;
+  o.clamp = 0;
+  o.normalize = VplNormalize::Object;
+  addVpls(*s, o);
+  // One object (the box): each VPL = total light intensity * kd / 500.
+  const Light& v = s->lights().lights.back();
+  EXPECT_NEAR(v.intensity.x, 2.0f * 0.5f / 500, 1e-6f);
+}
+
+TEST(Vpl, LimitsAndBadOptions) {
+  auto s = closedBox(0.5f, 1.0f);
+  VplOptions o;
+  o.count = 1000;
+  o.maxVpls = 100;
+  try {
+    addVpls(*s, o);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--max-vpls"), std::string::npos);
+  }
+  o.maxVpls = 1000000;
+  o.clamp = -1;
+  EXPECT_THROW(addVpls(*s, o), Error);
+  EXPECT_EQ(s->lights().size(), 1u);
+}
+
+TEST(Vpl, SpotAndDirectionalLightsShootIntoTheirCones) {
+  auto s = scene::Scene::build(io::parseRayString(R"(SBT-raytracer 1.0
+spot_light { position = (0, 0, 5); direction = (0, 0, -1); colour = (1, 1, 1); cutoff = 20; }
+directional_light { direction = (0, 0, -1); colour = (1e-6, 1e-6, 1e-6); }
+scale(100, square { material = { diffuse = (0.5, 0.5, 0.5); }; })
+)", "s.ray", ""));
+  VplOptions o;
+  o.count = 2000;
+  addVpls(*s, o);
+  size_t inCone = 0, vpls = 0;
+  for (const Light& l : s->lights().lights) {
+    if (l.type != LightType::Oriented) continue;
+    ++vpls;
+    inCone += std::hypot(l.position.x, l.position.y) <= 5 * std::tan(20 * kPi / 180) + 1e-3f;
+  }
+  EXPECT_GT(vpls, 1000u);
+  // The spot's VPLs all land inside its cone; the dim directional light's are few.
+  EXPECT_GT(double(inCone) / double(vpls), 0.9);
+}
+
+}  // namespace
+}  // namespace lc::lights
