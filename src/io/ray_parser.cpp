@@ -792,6 +792,7 @@ void Parser::areaLight(const Token& kw) {
   obj.mesh = int(scene_.meshes.size());
   scene_.meshes.push_back(std::move(mesh));
   obj.loc = lex_.loc(kw);
+  obj.twoSidedEmission = true;
   scene_.objects.push_back(std::move(obj));
 }
 

@@ -96,6 +96,9 @@ struct ObjectDesc {
   float height = 1, bottomRadius = 1, topRadius = 0;
   // mesh: index into SceneDesc::meshes
   int mesh = -1;
+  // Object lights: emit from both sides of the surface (area_light), not just along the
+  // outward/winding normal.
+  bool twoSidedEmission = false;
   SourceLoc loc;
 };
 

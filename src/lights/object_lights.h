@@ -26,7 +26,7 @@ struct ObjectLightOptions {
   ObjectLightKind kind = ObjectLightKind::Oriented;
   Placement placement = Placement::Stratified;
   uint64_t maxLights = 20'000'000;  // --max-lights
-  uint64_t seed = 1;
+  uint64_t seed = 1;  // unused so far: placement is a deterministic function of the geometry
 };
 
 // What was generated for one luminous object (for `lightcuts info` and --stats).

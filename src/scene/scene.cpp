@@ -132,6 +132,7 @@ std::unique_ptr<Scene> Scene::build(const io::SceneDesc& desc, const BuildOption
     sh.bottomRadius = od.bottomRadius;
     sh.topRadius = od.topRadius;
     sh.name = od.name;
+    sh.twoSidedEmission = od.twoSidedEmission;
     sh.loc = od.loc;
     if (!od.transform.isFinite() || !od.transform.inverseAffine(sh.toLocal))
       throw Error(od.loc, "the object's transform is singular or not finite (a zero scale?)");

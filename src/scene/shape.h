@@ -42,6 +42,7 @@ struct Shape {
   float height = 1, bottomRadius = 1, topRadius = 0;
   Bounds3 bounds;  // world space
   std::string name;
+  bool twoSidedEmission = false;  // object lights on both sides (io::ObjectDesc)
   SourceLoc loc;
 };
 
