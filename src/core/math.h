@@ -104,12 +104,8 @@ struct Bounds3 {
   constexpr float diagonal2() const { return empty() ? 0.0f : length2(hi - lo); }
   // Squared distance from p to the closest point of the box (0 inside).
   constexpr float distance2(const Vec3& p) const {
-    float d2 = 0;
-    for (int i = 0; i < 3; ++i) {
-      float d = std::max({lo[i] - p[i], 0.0f, p[i] - hi[i]});
-      d2 += d * d;
-    }
-    return d2;
+    Vec3 d = vmax(vmax(lo - p, Vec3(0.0f)), p - hi);
+    return dot(d, d);
   }
 };
 

@@ -12,14 +12,19 @@
 
 namespace lc::lightcuts {
 
-// An orthonormal frame whose w axis is the direction of interest.
+// An orthonormal frame whose w axis is the direction of interest, with the absolute
+// values of its axes (used to rotate box extents) computed once.
 struct Frame {
   Vec3 u, v, w;
+  Vec3 au, av, aw;
 };
 inline Frame makeFrame(const Vec3& w) {
   Frame f;
   f.w = w;
   orthonormalBasis(w, f.u, f.v);
+  f.au = vabs(f.u);
+  f.av = vabs(f.v);
+  f.aw = vabs(f.w);
   return f;
 }
 
@@ -29,10 +34,10 @@ inline Frame makeFrame(const Vec3& w) {
 // min y^2 + Mz^2), and <= 0 when Mz <= 0 (returned as 0).
 inline float cosBoundBox(const Frame& f, const Vec3& lo, const Vec3& hi) {
   Vec3 c = (lo + hi) * 0.5f, h = (hi - lo) * 0.5f;
-  float mz = dot(c, f.w) + dot(vabs(f.w), h);
+  float mz = dot(c, f.w) + dot(f.aw, h);
   if (mz <= 0) return 0;
-  float cx = dot(c, f.u), hx = dot(vabs(f.u), h);
-  float cy = dot(c, f.v), hy = dot(vabs(f.v), h);
+  float cx = dot(c, f.u), hx = dot(f.au, h);
+  float cy = dot(c, f.v), hy = dot(f.av, h);
   float ax = std::fabs(cx) - hx, ay = std::fabs(cy) - hy;  // distance of the x/y ranges from 0
   float x2 = ax > 0 ? ax * ax : 0, y2 = ay > 0 ? ay * ay : 0;
   return std::min(1.0f, mz / std::sqrt(x2 + y2 + mz * mz));

@@ -73,17 +73,24 @@ class Lightcuts final : public LightEvaluator {
   Lightcuts(const LightSet& lights, const LightForest& forest, const CutOptions& o)
       : lights_(lights), forest_(forest), opt_(o) {}
 
-  struct Item {
-    float bound;     // luminance of the error bound
+  // Nodes of the cut live in `nodes` (appended, never moved); the heap holds small
+  // (bound, index) entries so sifting stays cheap.
+  struct CutNode {
     uint32_t tree, node;
     Color unit;      // representative's M*G*V per unit intensity
     Color estimate;  // unit * cluster intensity
   };
+  struct Entry {
+    float bound;  // luminance of the node's error bound
+    uint32_t index;
+    bool operator<(const Entry& o) const { return bound < o.bound; }
+  };
 
   EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const override {
-    static thread_local std::vector<Item> heap;
+    static thread_local std::vector<Entry> heap;
+    static thread_local std::vector<CutNode> nodes;
     heap.clear();
-    auto less = [](const Item& a, const Item& b) { return a.bound < b.bound; };
+    nodes.clear();
     BoundFrames frames(sp);
     Color total(0);
     uint32_t cutSize = 0;
@@ -102,8 +109,9 @@ class Lightcuts final : public LightEvaluator {
       float b = luminance(clusterBound(n, tree.type, lights_.groups[tree.group], sp, frames));
       if (b > 0) {
         sumSq += double(b) * b;
-        heap.push_back(Item{b, t, ni, unit, est});
-        std::push_heap(heap.begin(), heap.end(), less);
+        heap.push_back(Entry{b, uint32_t(nodes.size())});
+        nodes.push_back(CutNode{t, ni, unit, est});
+        std::push_heap(heap.begin(), heap.end());
       }
     };
 
@@ -115,24 +123,24 @@ class Lightcuts final : public LightEvaluator {
     }
     const float eps = opt_.errorRatio;
     while (!heap.empty()) {
-      const Item& top = heap.front();
       if (cutSize >= uint32_t(opt_.maxCut)) break;
       float limit = eps * luminance(total);
+      const Entry top = heap.front();
       if (top.bound <= limit && (!rss || sumSq <= kTotalFactor * kTotalFactor * double(limit) * limit)) break;
-      Item it = top;
-      std::pop_heap(heap.begin(), heap.end(), less);
+      std::pop_heap(heap.begin(), heap.end());
       heap.pop_back();
-      sumSq = std::max(0.0, sumSq - double(it.bound) * it.bound);
-      total -= it.estimate;
+      sumSq = std::max(0.0, sumSq - double(top.bound) * top.bound);
+      const CutNode cn = nodes[top.index];
+      total -= cn.estimate;
       --cutSize;
-      const LightTree& tree = forest_.trees[it.tree];
+      const LightTree& tree = forest_.trees[cn.tree];
       const LightGroup& g = lights_.groups[tree.group];
-      const LightNode& n = tree.nodes[it.node];
+      const LightNode& n = tree.nodes[cn.node];
       for (uint32_t c = n.left; c <= n.left + 1; ++c) {
         uint32_t rep = tree.nodes[c].rep;
         // The child that shares the parent's representative reuses its shadow ray.
-        Color unit = rep == n.rep ? it.unit : shadowedUnit(lights_.lights[rep], g, sp, vis, stats);
-        addNode(it.tree, c, unit);
+        Color unit = rep == n.rep ? cn.unit : shadowedUnit(lights_.lights[rep], g, sp, vis, stats);
+        addNode(cn.tree, c, unit);
       }
     }
     stats.recordCut(cutSize);
