@@ -319,6 +319,9 @@ class Writer {
 
   void trimesh(const ObjectDesc& o, const MeshDesc& mesh, int material) {
     const bool bake = opt_.bakeTransforms;
+    // Baking the identity copies the data exactly (obj2ray): renormalising the normals
+    // would move them by an ulp and the .ray would no longer render the same image.
+    const bool identity = o.transform.m == Mat4::identity().m;
     Mat4 inv = Mat4::identity();
     if (bake && !o.transform.inverseAffine(inv))
       throw Error("cannot bake a singular transform into a mesh");
@@ -340,7 +343,9 @@ class Writer {
       }
       out_ += ");\n";
     };
-    vecList("points", n, [&](size_t i) { return bake ? o.transform.point(mesh.points[i]) : mesh.points[i]; });
+    vecList("points", n, [&](size_t i) {
+      return bake && !identity ? o.transform.point(mesh.points[i]) : mesh.points[i];
+    });
     out_ += in + "faces = (";
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
       const auto& t = mesh.triangles[i];
@@ -350,7 +355,7 @@ class Writer {
     out_ += ");\n";
     if (!mesh.normals.empty())
       vecList("normals", mesh.normals.size(), [&](size_t i) {
-        return bake ? normalize(inv.normalFromInverse(mesh.normals[i])) : mesh.normals[i];
+        return bake && !identity ? normalize(inv.normalFromInverse(mesh.normals[i])) : mesh.normals[i];
       });
     if (!mesh.uvs.empty()) {
       out_ += in + "texture_uv = (";
