@@ -32,11 +32,14 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
   scene::BuildOptions bo;
   bo.limits = o.limits;
   bo.threads = o.threads;
+  bo.linearizeSrgbTextures = o.linearizeSrgbTextures;
   out.scene = scene::Scene::build(desc, bo);
   out.accelSeconds = since(t1);
 
   auto t2 = Clock::now();
-  out.objectLights = lights::addObjectLights(*out.scene, o.objectLights);
+  lights::ObjectLightOptions olo = o.objectLights;
+  olo.maxLights = o.limits.maxLights;
+  out.objectLights = lights::addObjectLights(*out.scene, olo);
   if (o.gi) {
     lights::VplOptions v;
     const auto& ir = desc.instantRadiosity;

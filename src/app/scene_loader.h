@@ -25,6 +25,8 @@ struct LoadOptions {
   std::optional<float> vplClamp;
   uint64_t vplSeed = 1;
   bool gi = true;             // --gi off ignores instant_radiosity and --vpls
+  // Linearise sRGB-marked (MTL) textures: scene::BuildOptions::linearizeSrgbTextures.
+  bool linearizeSrgbTextures = false;
   bool quiet = false;
 };
 

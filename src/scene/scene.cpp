@@ -63,17 +63,25 @@ void embreeErrorFunc(void*, RTCError code, const char* str) {
   fmt::print(stderr, "embree error {}: {}\n", int(code), str ? str : "");
 }
 
-TexColor resolveColor(const io::ColorParam& p, TextureCache& cache, const Limits& limits) {
+// A texture through the cache; an sRGB-marked map is linearised only when the options ask.
+std::shared_ptr<const Texture> resolveTexture(const io::TextureRef& ref, TextureCache& cache,
+                                              const BuildOptions& options) {
+  io::TextureRef r = ref;
+  r.srgb = ref.srgb && options.linearizeSrgbTextures;
+  return cache.get(r, options.limits);
+}
+
+TexColor resolveColor(const io::ColorParam& p, TextureCache& cache, const BuildOptions& options) {
   TexColor c;
   c.value = p.value;
-  if (p.map) c.texture = cache.get(*p.map, limits);
+  if (p.map) c.texture = resolveTexture(*p.map, cache, options);
   return c;
 }
 
-TexScalar resolveScalar(const io::ScalarParam& p, TextureCache& cache, const Limits& limits) {
+TexScalar resolveScalar(const io::ScalarParam& p, TextureCache& cache, const BuildOptions& options) {
   TexScalar s;
   s.value = p.value;
-  if (p.map) s.texture = cache.get(*p.map, limits);
+  if (p.map) s.texture = resolveTexture(*p.map, cache, options);
   return s;
 }
 
@@ -95,19 +103,19 @@ std::unique_ptr<Scene> Scene::build(const io::SceneDesc& desc, const BuildOption
   for (const io::MaterialDesc& md : desc.materials) {
     Material m;
     m.name = md.name;
-    m.emissive = resolveColor(md.emissive, cache, options.limits);
-    m.ambient = resolveColor(md.ambient, cache, options.limits);
-    m.diffuse = resolveColor(md.diffuse, cache, options.limits);
-    m.specular = resolveColor(md.specular, cache, options.limits);
-    m.reflective = resolveColor(md.reflective, cache, options.limits);
-    m.transmissive = resolveColor(md.transmissive, cache, options.limits);
-    m.shininess = resolveScalar(md.shininess, cache, options.limits);
-    m.index = resolveScalar(md.index, cache, options.limits);
+    m.emissive = resolveColor(md.emissive, cache, options);
+    m.ambient = resolveColor(md.ambient, cache, options);
+    m.diffuse = resolveColor(md.diffuse, cache, options);
+    m.specular = resolveColor(md.specular, cache, options);
+    m.reflective = resolveColor(md.reflective, cache, options);
+    m.transmissive = resolveColor(md.transmissive, cache, options);
+    m.shininess = resolveScalar(md.shininess, cache, options);
+    m.index = resolveScalar(md.index, cache, options);
     m.emissiveSet = md.emissiveSet;
     if (md.luminosity) {
       const io::LuminosityDesc& ld = *md.luminosity;
       Luminosity l;
-      l.colour = ld.colourFromDiffuse ? m.diffuse : resolveColor(ld.colour, cache, options.limits);
+      l.colour = ld.colourFromDiffuse ? m.diffuse : resolveColor(ld.colour, cache, options);
       l.intensity = ld.intensity;
       l.density = ld.density;
       l.attenConstant = ld.attenConstant;

@@ -40,6 +40,10 @@ struct Hit {
 struct BuildOptions {
   Limits limits;
   int threads = 0;  // 0 = all cores
+  // Decode textures marked TextureRef::srgb (MTL colour maps) to linear values. Off, every
+  // 8-bit texture reads as value/255, as the course renderer did; the CLI turns it on with
+  // --tonemap srgb, whose output encoding undoes the linearisation.
+  bool linearizeSrgbTextures = false;
 };
 
 class Scene {
