@@ -43,6 +43,26 @@ inline float cosBoundBox(const Frame& f, const Vec3& lo, const Vec3& hi) {
   return std::min(1.0f, mz / std::sqrt(x2 + y2 + mz * mz));
 }
 
+// Lower bound of cos(angle(f.w, q)) over the box of vectors [lo, hi], or 0 when some
+// vector may be at 90 degrees or more: min z / max |q| after the same rotation.
+inline float cosLowerBoundBox(const Frame& f, const Vec3& lo, const Vec3& hi) {
+  Vec3 c = (lo + hi) * 0.5f, h = (hi - lo) * 0.5f;
+  float hz = dot(f.aw, h), cz = dot(c, f.w);
+  float minZ = cz - hz;
+  if (minZ <= 0) return 0;
+  float ax = std::fabs(dot(c, f.u)) + dot(f.au, h), ay = std::fabs(dot(c, f.v)) + dot(f.av, h);
+  float maxZ = cz + hz;
+  return minZ / std::sqrt(ax * ax + ay * ay + maxZ * maxZ);
+}
+
+// Narrows a cosine lower bound by a cone of half-angle beta: cos(theta + beta), 0 past 90.
+inline float coneNarrow(float cosTheta, float cosBeta) {
+  if (cosBeta <= 0 || cosTheta <= 0) return 0;
+  float sinTheta = std::sqrt(std::max(0.0f, 1 - cosTheta * cosTheta));
+  float sinBeta = std::sqrt(std::max(0.0f, 1 - cosBeta * cosBeta));
+  return std::max(0.0f, cosTheta * cosBeta - sinTheta * sinBeta);
+}
+
 // Widens a cosine bound by a cone of half-angle beta: directions within beta of the axis
 // can be up to beta closer to the target. cos(theta - beta) when theta > beta, else 1.
 inline float coneWiden(float cosTheta, float cosBeta) {
@@ -89,6 +109,37 @@ inline Color clusterBound(const LightNode& node, LightType type, const LightGrou
   }
   // A little slack so float rounding never puts the bound below an exact value.
   return m * (G * 1.0001f) * node.intensity;
+}
+
+// Lower bound (RGB) of the sum of the unshadowed contributions of the node's lights: with
+// the upper bound it brackets what the cluster gives when nothing blocks it, so
+// upper - lower bounds the error of an unoccluded cluster's estimate.
+inline Color clusterLowerBound(const LightNode& node, LightType type, const LightGroup& g,
+                               const ShadingPoint& sp, const BoundFrames& fr) {
+  Vec3 lo, hi;
+  if (type == LightType::Directional) {
+    lo = node.lo;
+    hi = node.hi;
+  } else {
+    lo = node.lo - sp.p;
+    hi = node.hi - sp.p;
+  }
+  float cN = cosLowerBoundBox(fr.n, lo, hi);
+  if (cN <= 0) return Color(0);
+  Color m = sp.kd * cN;
+  if (!g.diffuseOnly && sp.hasSpecular()) m += sp.ks * std::pow(cosLowerBoundBox(fr.r, lo, hi), sp.shininess);
+  float G = 1;
+  if (type != LightType::Directional) {
+    // The farthest point of the box: attenuation does not increase with distance.
+    Vec3 far = vmax(vabs(lo), vabs(hi));
+    G = g.atten(length(far));
+    if (type == LightType::Oriented || type == LightType::Spot) {
+      // 0 means "may be 90 degrees or more", not a cosine: no lower bound then.
+      float cL = coneNarrow(cosLowerBoundBox(makeFrame(node.axis), -hi, -lo), node.cosHalfAngle);
+      G *= cL <= 0 ? 0.0f : (type == LightType::Oriented ? cL : g.falloff(cL));
+    }
+  }
+  return m * (G * 0.9999f) * node.intensity;
 }
 
 }  // namespace lc::lightcuts

@@ -190,3 +190,29 @@ TEST(ConeUnion, ContainsBothCones) {
 
 }  // namespace
 }  // namespace lc::lightcuts
+
+namespace lc::lightcuts {
+namespace {
+
+// The lower bound never exceeds the true unshadowed sum (and so brackets it with the upper).
+TEST_P(BoundProperty, LowerBoundIsAtMostTheTrueSum) {
+  LightType type = GetParam();
+  Rng r(777, uint64_t(type));
+  int positive = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Config c = randomConfig(r, type);
+    BoundFrames fr(c.sp);
+    Color lb = clusterLowerBound(c.node, type, c.set.groups[0], c.sp, fr);
+    Color ub = clusterBound(c.node, type, c.set.groups[0], c.sp, fr);
+    Color t = trueSum(c);
+    for (int ch = 0; ch < 3; ++ch) {
+      ASSERT_LE(lb[ch], t[ch] * (1 + 1e-5f) + 1e-12f) << "config " << i << " type " << lightTypeName(type);
+      ASSERT_LE(lb[ch], ub[ch] + 1e-12f);
+    }
+    positive += luminance(lb) > 0;
+  }
+  EXPECT_GT(positive, 500);  // and is not trivially zero
+}
+
+}  // namespace
+}  // namespace lc::lightcuts

@@ -28,9 +28,11 @@ const char* methodName(Method m);
 //   Walter: every node's error bound is below errorRatio times the total estimate (Walter
 //     et al. 2005). The errors of many nodes near the threshold add up, so the total
 //     error is often a few times errorRatio.
-//   Total: the same, and also the root-sum-square of the bounds is below 2 x errorRatio
-//     times the estimate: the cut's errors are of random sign and well below their
-//     bounds, so this keeps the total error, not just each node's, under errorRatio.
+//   Total: the same, and also the root-sum-square of the nodes' error spreads is below
+//     1.5 x errorRatio times the estimate. A node's spread is its upper bound, or, when
+//     its representative is visible, its upper minus its lower bound (what the estimate
+//     of an unoccluded cluster can be off by). The errors of a cut have random signs, so
+//     this keeps the total error, not just each node's, near errorRatio.
 enum class CutCriterion { Walter, Total };
 CutCriterion parseCutCriterion(const std::string& name);  // "walter" | "total"
 const char* cutCriterionName(CutCriterion c);
