@@ -87,6 +87,8 @@ int runRender(RenderArgs& a) {
   io::ToneMap tonemap = a.tonemap == "srgb" ? io::ToneMap::Srgb : io::ToneMap::Clamp;
 
   a.load.threads = a.threads;
+  // sRGB texture maps (from MTL files) are linearised only for a physically based output.
+  a.load.linearizeSrgbTextures = tonemap == io::ToneMap::Srgb;
   a.load.quiet = a.quiet;
   LoadedScene ls = loadScene(a.scene, a.load);
   scene::Scene& scene = *ls.scene;
