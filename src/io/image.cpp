@@ -227,6 +227,9 @@ void writeImage(const std::string& path, const Image& image, ToneMap tonemap) {
 Image readImage(const std::string& path, bool srgb, uint64_t maxPixels) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throwOpen(path, "it is a directory");
+  // A device or FIFO could block or never end (e.g. map("/dev/stdin")).
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throwOpen(path, "not a regular file");
   std::unique_ptr<FILE, FileCloser> f(std::fopen(path.c_str(), "rb"));
   if (!f) throwOpen(path, std::strerror(errno));
 

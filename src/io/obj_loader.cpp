@@ -562,6 +562,8 @@ void openCheck(const std::string& path, const SourceLoc& referredFrom, const Lim
   };
   std::error_code ec;
   if (fs::is_directory(path, ec)) fail(std::strerror(EISDIR));
+  // A device or FIFO could block or never end (obj_mesh { file = "/dev/zero"; }).
+  if (fs::exists(path, ec) && !fs::is_regular_file(path, ec)) fail("not a regular file");
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (!f) fail(std::strerror(errno));
   std::fclose(f);

@@ -5,7 +5,10 @@
 
 #include <cfloat>
 #include <charconv>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <unordered_map>
@@ -1190,12 +1193,36 @@ SceneDesc parseRayString(const std::string& text, const std::string& name, const
 }
 
 SceneDesc parseRayFile(const std::string& path, const ParseOptions& options) {
+  namespace fs = std::filesystem;
+  const uint64_t limit = options.limits.maxFileBytes;
+  auto tooLarge = [&] {
+    return Error("'" + path + "' is larger than the limit of " + std::to_string(limit) + " bytes");
+  };
   std::error_code ec;
-  auto size = std::filesystem::file_size(path, ec);
-  if (!ec && size > options.limits.maxFileBytes)
-    throw Error("'" + path + "' is larger than the limit of " + std::to_string(options.limits.maxFileBytes) +
-                " bytes");
-  std::string text = readFile(path);
+  fs::file_status st = fs::status(path, ec);
+  std::string text;
+  if (!ec && st.type() == fs::file_type::fifo) {
+    // A pipe (render <(generator) or /dev/stdin): read it up to the size limit.
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) throw Error("cannot open '" + path + "': " + std::strerror(errno));
+    char buf[1 << 16];
+    size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) {
+      text.append(buf, n);
+      if (text.size() > limit) {
+        std::fclose(f);
+        throw tooLarge();
+      }
+    }
+    std::fclose(f);
+  } else {
+    // Devices and sockets could block or never end (/dev/zero).
+    if (!ec && fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st))
+      throw Error("cannot read '" + path + "': not a regular file");
+    auto size = fs::file_size(path, ec);
+    if (!ec && size > limit) throw tooLarge();
+    text = readFile(path);
+  }
   return parseRayString(text, path, parentDir(path), options);
 }
 
