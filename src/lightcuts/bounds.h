@@ -78,9 +78,37 @@ struct BoundFrames {
   explicit BoundFrames(const ShadingPoint& sp) : n(makeFrame(sp.n)), r(makeFrame(sp.r)) {}
 };
 
-// Upper bound (RGB) of the sum of the unshadowed contributions of the node's lights.
-inline Color clusterBound(const LightNode& node, LightType type, const LightGroup& g,
-                          const ShadingPoint& sp, const BoundFrames& fr) {
+// A box of vectors seen in a frame: centre and half extent along each axis.
+struct RotatedBox {
+  float cx, hx, cy, hy, cz, hz;
+  RotatedBox(const Frame& f, const Vec3& c, const Vec3& h)
+      : cx(dot(c, f.u)), hx(dot(f.au, h)), cy(dot(c, f.v)), hy(dot(f.av, h)), cz(dot(c, f.w)), hz(dot(f.aw, h)) {}
+  // Upper bound of the cosine to the frame's axis (as cosBoundBox).
+  float cosUpper() const {
+    float mz = cz + hz;
+    if (mz <= 0) return 0;
+    float ax = std::fabs(cx) - hx, ay = std::fabs(cy) - hy;
+    float x2 = ax > 0 ? ax * ax : 0, y2 = ay > 0 ? ay * ay : 0;
+    return std::min(1.0f, mz / std::sqrt(x2 + y2 + mz * mz));
+  }
+  // Lower bound (as cosLowerBoundBox); 0 when some vector may be at 90 degrees or more.
+  float cosLower() const {
+    float minZ = cz - hz;
+    if (minZ <= 0) return 0;
+    float ax = std::fabs(cx) + hx, ay = std::fabs(cy) + hy, maxZ = cz + hz;
+    return minZ / std::sqrt(ax * ax + ay * ay + maxZ * maxZ);
+  }
+};
+
+// Upper bound (RGB) of the sum of the unshadowed contributions of the node's lights and,
+// when `lower` is given, a lower bound: with visibility 1 the cluster gives something in
+// [lower, upper], so upper - lower bounds the error of an unoccluded cluster's estimate.
+inline Color clusterBounds(const LightNode& node, LightType type, const LightGroup& g, const ShadingPoint& sp,
+                           const BoundFrames& fr, Color* lower) {
+  // Cosine bounds get a little slack so float rounding in the exact evaluation can never
+  // exceed them (steep spot falloffs and high Phong exponents amplify it).
+  constexpr float kSlack = 2e-5f;
+  if (lower) *lower = Color(0);
   Vec3 lo, hi;  // vectors from the shading point toward the cluster's lights
   if (type == LightType::Directional) {
     lo = node.lo;
@@ -89,57 +117,51 @@ inline Color clusterBound(const LightNode& node, LightType type, const LightGrou
     lo = node.lo - sp.p;
     hi = node.hi - sp.p;
   }
-  // Cosine bounds get a little slack so float rounding in the exact evaluation can never
-  // exceed them (steep spot falloffs and high Phong exponents amplify it).
-  constexpr float kSlack = 2e-5f;
-  float cN = cosBoundBox(fr.n, lo, hi);
+  Vec3 c = (lo + hi) * 0.5f, h = (hi - lo) * 0.5f;
+  RotatedBox bn(fr.n, c, h);
+  float cN = bn.cosUpper();
   if (cN <= 0) return Color(0);  // every light is behind the surface
-  Color m = sp.kd * std::min(1.0f, cN + kSlack);
-  if (!g.diffuseOnly && sp.hasSpecular())
-    m += sp.ks * std::pow(std::min(1.0f, cosBoundBox(fr.r, lo, hi) + kSlack), sp.shininess);
-  float G = 1;
+  bool specular = !g.diffuseOnly && sp.hasSpecular();
+  Color mUp = sp.kd * std::min(1.0f, cN + kSlack);
+  // Lights that may be behind the surface give nothing at all (no specular either).
+  float cNLo = lower ? bn.cosLower() : 0.0f;
+  Color mLo = sp.kd * cNLo;
+  if (specular) {
+    RotatedBox br(fr.r, c, h);
+    mUp += sp.ks * std::pow(std::min(1.0f, br.cosUpper() + kSlack), sp.shininess);
+    if (cNLo > 0) mLo += sp.ks * std::pow(br.cosLower(), sp.shininess);
+  }
+  float gUp = 1, gLo = 1;
   if (type != LightType::Directional) {
-    Bounds3 box(node.lo, node.hi);
-    G = g.atten(std::sqrt(box.distance2(sp.p)));
+    gUp = g.atten(std::sqrt(Bounds3(node.lo, node.hi).distance2(sp.p)));
+    if (lower) gLo = g.atten(length(vmax(vabs(lo), vabs(hi))));  // the farthest corner
     if (type == LightType::Oriented || type == LightType::Spot) {
-      // Directions from the lights to the point lie in the box [-hi, -lo].
-      float cL = std::min(1.0f, coneWiden(cosBoundBox(makeFrame(node.axis), -hi, -lo), node.cosHalfAngle) + kSlack);
-      G *= type == LightType::Oriented ? std::max(0.0f, cL) : g.falloff(cL);
+      // Directions from the lights to the point lie in the box -[lo, hi].
+      RotatedBox bl(makeFrame(node.axis), -c, h);
+      float cUp = std::min(1.0f, coneWiden(bl.cosUpper(), node.cosHalfAngle) + kSlack);
+      gUp *= type == LightType::Oriented ? std::max(0.0f, cUp) : g.falloff(cUp);
+      if (lower) {
+        // 0 means "may be 90 degrees or more", not a cosine: no lower bound then.
+        float cLo = coneNarrow(bl.cosLower(), node.cosHalfAngle);
+        gLo *= cLo <= 0 ? 0.0f : (type == LightType::Oriented ? cLo : g.falloff(cLo));
+      }
     }
   }
+  if (lower) *lower = mLo * (gLo * 0.9999f) * node.intensity;
   // A little slack so float rounding never puts the bound below an exact value.
-  return m * (G * 1.0001f) * node.intensity;
+  return mUp * (gUp * 1.0001f) * node.intensity;
 }
 
-// Lower bound (RGB) of the sum of the unshadowed contributions of the node's lights: with
-// the upper bound it brackets what the cluster gives when nothing blocks it, so
-// upper - lower bounds the error of an unoccluded cluster's estimate.
+inline Color clusterBound(const LightNode& node, LightType type, const LightGroup& g, const ShadingPoint& sp,
+                          const BoundFrames& fr) {
+  return clusterBounds(node, type, g, sp, fr, nullptr);
+}
+
 inline Color clusterLowerBound(const LightNode& node, LightType type, const LightGroup& g,
                                const ShadingPoint& sp, const BoundFrames& fr) {
-  Vec3 lo, hi;
-  if (type == LightType::Directional) {
-    lo = node.lo;
-    hi = node.hi;
-  } else {
-    lo = node.lo - sp.p;
-    hi = node.hi - sp.p;
-  }
-  float cN = cosLowerBoundBox(fr.n, lo, hi);
-  if (cN <= 0) return Color(0);
-  Color m = sp.kd * cN;
-  if (!g.diffuseOnly && sp.hasSpecular()) m += sp.ks * std::pow(cosLowerBoundBox(fr.r, lo, hi), sp.shininess);
-  float G = 1;
-  if (type != LightType::Directional) {
-    // The farthest point of the box: attenuation does not increase with distance.
-    Vec3 far = vmax(vabs(lo), vabs(hi));
-    G = g.atten(length(far));
-    if (type == LightType::Oriented || type == LightType::Spot) {
-      // 0 means "may be 90 degrees or more", not a cosine: no lower bound then.
-      float cL = coneNarrow(cosLowerBoundBox(makeFrame(node.axis), -hi, -lo), node.cosHalfAngle);
-      G *= cL <= 0 ? 0.0f : (type == LightType::Oriented ? cL : g.falloff(cL));
-    }
-  }
-  return m * (G * 0.9999f) * node.intensity;
+  Color lower;
+  clusterBounds(node, type, g, sp, fr, &lower);
+  return lower;
 }
 
 }  // namespace lc::lightcuts

@@ -109,14 +109,15 @@ class Lightcuts final : public LightEvaluator {
       if (n.isLeaf()) return;
       ++stats.boundsEvaluated;
       const LightGroup& g = lights_.groups[tree.group];
-      float b = luminance(clusterBound(n, tree.type, g, sp, frames));
+      // The total criterion adds up how far each estimate may be off: a cluster whose
+      // representative is visible is assumed unoccluded, so its estimate is within the
+      // upper minus the lower bound of its unshadowed light; otherwise (or when it is
+      // partly hidden, which the per-node rule still bounds) within the upper bound.
+      bool visible = rss && !isBlack(unit);
+      Color lower;
+      float b = luminance(clusterBounds(n, tree.type, g, sp, frames, visible ? &lower : nullptr));
       if (b > 0) {
-        // The total criterion adds up how far each estimate may be off: a cluster whose
-        // representative is visible is assumed unoccluded, so its estimate is within the
-        // upper minus the lower bound of its unshadowed light; otherwise (or when it is
-        // partly hidden, which the per-node rule still bounds) within the upper bound.
-        float spread = b;
-        if (rss && !isBlack(unit)) spread = std::max(0.0f, b - luminance(clusterLowerBound(n, tree.type, g, sp, frames)));
+        float spread = visible ? std::max(0.0f, b - luminance(lower)) : b;
         sumSq += double(spread) * spread;
         heap.push_back(Entry{b, uint32_t(nodes.size()), spread});
         nodes.push_back(CutNode{t, ni, unit, est});
