@@ -78,7 +78,8 @@ struct BoundFrames {
   explicit BoundFrames(const ShadingPoint& sp) : n(makeFrame(sp.n)), r(makeFrame(sp.r)) {}
 };
 
-// A box of vectors seen in a frame: centre and half extent along each axis.
+// A box of vectors seen in a frame: centre and half extent along each axis (the box
+// rotated into the frame and re-bounded).
 struct RotatedBox {
   float cx, hx, cy, hy, cz, hz;
   RotatedBox(const Frame& f, const Vec3& c, const Vec3& h)
@@ -121,28 +122,36 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
   RotatedBox bn(fr.n, c, h);
   float cN = bn.cosUpper();
   if (cN <= 0) return Color(0);  // every light is behind the surface
+  // Nearest and farthest vectors of the box: |q| lies in [dMin, dMax] for all of them.
+  float dMax = length(vmax(vabs(lo), vabs(hi)));
+  float dMin = std::sqrt(dot(vmax(vmax(lo, -hi), Vec3(0.0f)), vmax(vmax(lo, -hi), Vec3(0.0f))));
+  // Lower cosine bounds: the smallest projection over the longest vector. Lights that may
+  // be behind the surface give nothing at all, so no lower bound then (specular neither).
+  float cNLo = lower && dMax > 0 ? std::max(0.0f, (bn.cz - bn.hz) / dMax) : 0.0f;
   bool specular = !g.diffuseOnly && sp.hasSpecular();
   Color mUp = sp.kd * std::min(1.0f, cN + kSlack);
-  // Lights that may be behind the surface give nothing at all (no specular either).
-  float cNLo = lower ? bn.cosLower() : 0.0f;
   Color mLo = sp.kd * cNLo;
   if (specular) {
     RotatedBox br(fr.r, c, h);
     mUp += sp.ks * std::pow(std::min(1.0f, br.cosUpper() + kSlack), sp.shininess);
-    if (cNLo > 0) mLo += sp.ks * std::pow(br.cosLower(), sp.shininess);
+    if (cNLo > 0) mLo += sp.ks * std::pow(std::max(0.0f, (br.cz - br.hz) / dMax), sp.shininess);
   }
   float gUp = 1, gLo = 1;
   if (type != LightType::Directional) {
-    gUp = g.atten(std::sqrt(Bounds3(node.lo, node.hi).distance2(sp.p)));
-    if (lower) gLo = g.atten(length(vmax(vabs(lo), vabs(hi))));  // the farthest corner
+    gUp = g.atten(dMin);
+    if (lower) gLo = g.atten(dMax);
     if (type == LightType::Oriented || type == LightType::Spot) {
-      // Directions from the lights to the point lie in the box -[lo, hi].
-      RotatedBox bl(makeFrame(node.axis), -c, h);
-      float cUp = std::min(1.0f, coneWiden(bl.cosUpper(), node.cosHalfAngle) + kSlack);
+      // The light's cosine is between its axis a and the direction from a light to the
+      // point, which lies in the box -[lo, hi]: projection onto a over the length, bounded
+      // by the projection's range and [dMin, dMax]; then widened/narrowed by the cone.
+      float pc = -dot(c, node.axis), ph = dot(vabs(node.axis), h);
+      float up = pc + ph;
+      float cosUp = up <= 0 ? 0.0f : (dMin > 0 ? std::min(1.0f, up / dMin) : 1.0f);
+      float cUp = std::min(1.0f, coneWiden(cosUp, node.cosHalfAngle) + kSlack);
       gUp *= type == LightType::Oriented ? std::max(0.0f, cUp) : g.falloff(cUp);
       if (lower) {
         // 0 means "may be 90 degrees or more", not a cosine: no lower bound then.
-        float cLo = coneNarrow(bl.cosLower(), node.cosHalfAngle);
+        float cLo = dMax > 0 ? coneNarrow(std::max(0.0f, (pc - ph) / dMax), node.cosHalfAngle) : 0.0f;
         gLo *= cLo <= 0 ? 0.0f : (type == LightType::Oriented ? cLo : g.falloff(cLo));
       }
     }
