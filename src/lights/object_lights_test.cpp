@@ -781,7 +781,7 @@ TEST(ObjectLights, CornellBoxFloorIsLitBelowThePanel) {
   auto sc = Scene::build(io::parseRayFile(testing::scenePath("cornell_box.ray")));
   auto info = addObjectLights(*sc, {});
   ASSERT_EQ(info.size(), 1u);
-  EXPECT_EQ(info[0].lights, 1024u);  // two triangles of 6825 mm^2 at 0.075: 512 each
+  EXPECT_EQ(info[0].lights, 256u);  // two triangles of 6825 mm^2 at 0.0188: 128 each
   EXPECT_NEAR(info[0].power.x, 300000, 1);
   const LightSet& set = sc->lights();
   auto irradiance = [&](Vec3 p, bool shadows) {
