@@ -147,8 +147,10 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
       float pc = -dot(c, node.axis), ph = dot(vabs(node.axis), h);
       float up = pc + ph;
       float cosUp = up <= 0 ? 0.0f : (dMin > 0 ? std::min(1.0f, up / dMin) : 1.0f);
-      float cUp = std::min(1.0f, coneWiden(cosUp, node.cosHalfAngle) + kSlack);
-      gUp *= type == LightType::Oriented ? std::max(0.0f, cUp) : g.falloff(cUp);
+      // The slack only rounds a positive bound up: a zero bound is exact (nothing reaches).
+      float cUp = coneWiden(cosUp, node.cosHalfAngle);
+      if (cUp > 0) cUp = std::min(1.0f, cUp + kSlack);
+      gUp *= type == LightType::Oriented ? cUp : g.falloff(cUp);
       if (lower) {
         // 0 means "may be 90 degrees or more", not a cosine: no lower bound then.
         float cLo = dMax > 0 ? coneNarrow(std::max(0.0f, (pc - ph) / dMax), node.cosHalfAngle) : 0.0f;
