@@ -185,10 +185,16 @@ Vec2 quadricUv(const Shape& s, const Vec3& p, int part) {
       return Vec2(angleU(p), 0.5f + std::asin(z) / kPi);
     }
     case ShapeKind::Box: {
-      int axis = part / 2;
-      int a = (axis + 1) % 3, b = (axis + 2) % 3;
-      if (axis == 1) std::swap(a, b);  // keep (u, v) right-handed about each face normal
-      return Vec2(p[a] + 0.5f, p[b] + 0.5f);
+      // (u, v) right-handed about each face's outward normal, so no face shows its texture
+      // mirrored: x faces (+-y, z), y faces (-+x, z), z faces (+-x, y).
+      switch (part) {
+        case 0: return Vec2(0.5f - p.y, p.z + 0.5f);  // -x
+        case 1: return Vec2(p.y + 0.5f, p.z + 0.5f);  // +x
+        case 2: return Vec2(p.x + 0.5f, p.z + 0.5f);  // -y
+        case 3: return Vec2(0.5f - p.x, p.z + 0.5f);  // +y
+        case 4: return Vec2(0.5f - p.x, p.y + 0.5f);  // -z
+        default: return Vec2(p.x + 0.5f, p.y + 0.5f);  // +z
+      }
     }
     case ShapeKind::Square: return Vec2(p.x + 0.5f, p.y + 0.5f);
     case ShapeKind::Cylinder:

@@ -7,9 +7,9 @@
 //   square    [-0.5, 0.5]^2 in the plane z = 0, normal +z
 //   cylinder  radius 1 about z, z in [0, 1]; caps at z = 0 and z = 1 when capped
 //   cone      along +z, radius bottomRadius at z = 0 to topRadius at z = height; caps when capped
-// Texture coordinates (documented in docs/SCENE_FORMAT.md):
+// Texture coordinates (documented in docs/TEXTURES.md):
 //   sphere    u = longitude/(2 pi) about z from +x, v = 0.5 + latitude/pi (0 at z = -1)
-//   box       per face, the face's two in-plane coordinates + 0.5
+//   box       per face, two in-plane coordinates + 0.5, right-handed about the outward normal
 //   square    (x + 0.5, y + 0.5)
 //   cylinder/cone body u = angle/(2 pi), v = z/height; caps ((x/r + 1)/2, (y/r + 1)/2)
 #pragma once

@@ -62,14 +62,15 @@ TEST(QuadricUv, SpherePolesAndEquator) {
 
 TEST(QuadricUv, BoxFaces) {
   Shape s = shapeOf(ShapeKind::Box);
-  // part = 2 * axis + (1 for the + face). Each face maps two in-plane coordinates + 0.5:
-  //   x faces (parts 0, 1): (y, z);  y faces (2, 3): (x, z);  z faces (4, 5): (x, y).
+  // part = 2 * axis + (1 for the + face). Each face maps two in-plane coordinates + 0.5,
+  // right-handed about its outward normal (u x v = n), so no face is mirrored:
+  //   x faces (parts 0, 1): (-y | y, z);  y faces (2, 3): (x | -x, z);  z faces (4, 5): (-x | x, y).
   const Vec3 p(0.3f, -0.2f, 0.1f);  // an interior point; the fixed coordinate is unused
-  expectUv(quadricUv(s, Vec3(-0.5f, p.y, p.z), 0), p.y + 0.5f, p.z + 0.5f);
+  expectUv(quadricUv(s, Vec3(-0.5f, p.y, p.z), 0), 0.5f - p.y, p.z + 0.5f);
   expectUv(quadricUv(s, Vec3(0.5f, p.y, p.z), 1), p.y + 0.5f, p.z + 0.5f);
   expectUv(quadricUv(s, Vec3(p.x, -0.5f, p.z), 2), p.x + 0.5f, p.z + 0.5f);
-  expectUv(quadricUv(s, Vec3(p.x, 0.5f, p.z), 3), p.x + 0.5f, p.z + 0.5f);
-  expectUv(quadricUv(s, Vec3(p.x, p.y, -0.5f), 4), p.x + 0.5f, p.y + 0.5f);
+  expectUv(quadricUv(s, Vec3(p.x, 0.5f, p.z), 3), 0.5f - p.x, p.z + 0.5f);
+  expectUv(quadricUv(s, Vec3(p.x, p.y, -0.5f), 4), 0.5f - p.x, p.y + 0.5f);
   expectUv(quadricUv(s, Vec3(p.x, p.y, 0.5f), 5), p.x + 0.5f, p.y + 0.5f);
   // Face corners span the whole [0, 1]^2.
   expectUv(quadricUv(s, Vec3(-0.5f, -0.5f, 0.5f), 5), 0, 0);
@@ -162,9 +163,9 @@ TEST(QuadricUvTransformed, BoxFaceUnderNonUniformScale) {
   EXPECT_NEAR(h.p.z, 3.5f, 1e-4f);
   // Local (0.25, -0.25) on the +z face.
   expectUv(h.uv, 0.75f, 0.25f, 1e-4f);
-  // The -x face: local (y, z) = (0.25, 0.1).
+  // The -x face: local (y, z) = (0.25, 0.1), u running along -y.
   Hit side = shoot(*s, Vec3(-10, 0.5f, 3.1f), Vec3(1, 0, 0));
-  expectUv(side.uv, 0.75f, 0.6f, 1e-4f);
+  expectUv(side.uv, 0.25f, 0.6f, 1e-4f);
 }
 
 TEST(QuadricUvTransformed, SquareRotatedToFaceX) {
