@@ -68,7 +68,7 @@ RenderResult render(const scene::Scene& scene, const lightcuts::LightEvaluator& 
 // fewer when the scene has so many VPLs that points x VPLs would exceed `maxEvaluations`.
 // 0 when the scene has no VPLs.
 double vplClampedFraction(const scene::Scene& scene, const RenderOptions& options, int points = 256,
-                          uint64_t maxEvaluations = 20'000'000);
+                          uint64_t maxEvaluations = 2'000'000);
 
 // Radiance along one camera ray (exposed for tests).
 Color traceRay(const scene::Scene& scene, const lightcuts::LightEvaluator& evaluator, const scene::Ray& ray,
