@@ -7,6 +7,7 @@
 #include "app/commands.h"
 #include "app/scene_loader.h"
 #include "app/scene_options.h"
+#include "app/summary.h"
 
 namespace lc::app {
 
@@ -43,18 +44,11 @@ int runInfo(InfoArgs& a) {
   j["objects_by_kind"] = shapes;
   j["triangles"] = s.triangleCount();
   j["materials"] = s.materials().size();
-  nlohmann::json lights;
-  for (int t = 0; t < kLightTypeCount; ++t) lights[lightTypeName(LightType(t))] = L.countOf(LightType(t));
-  lights["total"] = L.size();
-  j["lights"] = lights;
+  j["lights"] = lightCountsJson(L);
   j["ambient"] = {s.ambient().x, s.ambient().y, s.ambient().z};
   const Bounds3& b = s.bounds();
   j["bounds"] = {{"min", {b.lo.x, b.lo.y, b.lo.z}}, {"max", {b.hi.x, b.hi.y, b.hi.z}}};
-  nlohmann::json objs = nlohmann::json::array();
-  for (const auto& o : ls.objectLights)
-    objs.push_back({{"shape", o.shape}, {"name", o.name}, {"lights", o.lights}, {"area", o.area},
-                    {"power", {o.power.x, o.power.y, o.power.z}}});
-  j["object_lights"] = objs;
+  j["object_lights"] = objectLightsJson(ls.objectLights);
   j["vpls"] = ls.vpls.vpls;
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
@@ -66,10 +60,7 @@ int runInfo(InfoArgs& a) {
   fmt::print("objects    {} ({})\n", s.shapes().size(), kinds);
   fmt::print("triangles  {}\n", s.triangleCount());
   fmt::print("materials  {}\n", s.materials().size());
-  std::string lk;
-  for (int t = 0; t < kLightTypeCount; ++t)
-    if (size_t c = L.countOf(LightType(t))) lk += fmt::format("{}{} {}", lk.empty() ? "" : ", ", c, lightTypeName(LightType(t)));
-  fmt::print("lights     {}{}\n", L.size(), lk.empty() ? "" : " (" + lk + ")");
+  fmt::print("lights     {}\n", lightCountsLine(L));
   fmt::print("ambient    ({}, {}, {})\n", s.ambient().x, s.ambient().y, s.ambient().z);
   if (!b.empty())
     fmt::print("bounds     ({:.4g}, {:.4g}, {:.4g}) .. ({:.4g}, {:.4g}, {:.4g})\n", b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z);

@@ -11,6 +11,7 @@
 #include "app/progress.h"
 #include "app/scene_loader.h"
 #include "app/scene_options.h"
+#include "app/summary.h"
 #include "core/file_util.h"
 #include "io/colormap.h"
 #include "io/image.h"
@@ -59,13 +60,6 @@ std::string defaultOutput(const std::string& scene) {
   size_t dot = stem.find_last_of('.');
   if (dot != std::string::npos && dot > 0) stem = stem.substr(0, dot);
   return stem + ".png";
-}
-
-nlohmann::json lightCounts(const LightSet& ls) {
-  nlohmann::json j;
-  for (int t = 0; t < kLightTypeCount; ++t) j[lightTypeName(LightType(t))] = ls.countOf(LightType(t));
-  j["total"] = ls.size();
-  return j;
 }
 
 int runRender(RenderArgs& a) {
@@ -187,7 +181,7 @@ int runRender(RenderArgs& a) {
     j["shadow_rays"] = es.shadowRays;
     j["rays_per_second"] = rr.stats.seconds > 0 ? double(allRays) / rr.stats.seconds : 0;
     j["shading_points"] = es.shadingPoints;
-    j["lights"] = lightCounts(scene.lights());
+    j["lights"] = lightCountsJson(scene.lights());
     j["avg_lights_per_shading_point"] = perPoint;
     j["avg_shadow_rays_per_shading_point"] = raysPerPoint;
     j["bounds_evaluated"] = es.boundsEvaluated;
@@ -204,11 +198,7 @@ int runRender(RenderArgs& a) {
       j["tree_count"] = forest.trees.size();
       j["tree_memory_bytes"] = forest.memoryBytes();
     }
-    nlohmann::json objs = nlohmann::json::array();
-    for (const auto& o : ls.objectLights)
-      objs.push_back({{"shape", o.shape}, {"name", o.name}, {"lights", o.lights}, {"area", o.area},
-                      {"power", {o.power.x, o.power.y, o.power.z}}});
-    j["object_lights"] = objs;
+    j["object_lights"] = objectLightsJson(ls.objectLights);
     j["vpls"] = {{"paths", ls.vpls.paths}, {"count", ls.vpls.vpls}, {"time_s", ls.vpls.seconds},
                  {"clamp_distance", ls.vpls.clampDistance}};
     j["vpl_clamped_fraction"] = clampedFraction;
@@ -236,11 +226,8 @@ int runRender(RenderArgs& a) {
 
   if (!a.quiet) {
     const LightSet& L = scene.lights();
-    std::string kinds;
-    for (int t = 0; t < kLightTypeCount; ++t)
-      if (size_t c = L.countOf(LightType(t))) kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", c, lightTypeName(LightType(t)));
     fmt::print("scene      {} ({} objects, {} triangles)\n", a.scene, scene.shapes().size(), scene.triangleCount());
-    fmt::print("lights     {}{}\n", L.size(), kinds.empty() ? "" : " (" + kinds + ")");
+    fmt::print("lights     {}\n", lightCountsLine(L));
     if (ls.vpls.vpls)
       fmt::print("vpls       {} from {} paths in {}; clamp at {:.4g} removes {:.1f}% of their light\n", ls.vpls.vpls,
                  ls.vpls.paths, formatSeconds(ls.vpls.seconds), ls.vpls.clampDistance, 100 * clampedFraction);

@@ -1,0 +1,21 @@
+// Descriptions of a loaded scene's lights shared by `render` and `info`: as JSON for
+// --stats/--json and as one line for the terminal.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "lights/object_lights.h"
+#include "scene/light.h"
+
+namespace lc::app {
+
+// {"omni": n, "oriented": n, "spot": n, "directional": n, "total": n}
+nlohmann::json lightCountsJson(const LightSet& lights);
+// "9166 (256 oriented, ...)": the total, then the non-zero kinds.
+std::string lightCountsLine(const LightSet& lights);
+// One object per luminous object: shape, name, lights, area, power.
+nlohmann::json objectLightsJson(const std::vector<lights::ObjectLightInfo>& infos);
+
+}  // namespace lc::app
