@@ -1,0 +1,60 @@
+// End to end: Lightcuts against brute force on the default scene (object-light panel plus
+// instant radiosity), the acceptance criterion of the product at a size a test can afford.
+#include <gtest/gtest.h>
+
+#include "io/image_metrics.h"
+#include "io/ray_parser.h"
+#include "lights/object_lights.h"
+#include "lights/vpl.h"
+#include "render/renderer.h"
+#include "test_util.h"
+
+namespace lc::render {
+namespace {
+
+struct Loaded {
+  std::unique_ptr<scene::Scene> scene;
+};
+
+Loaded loadCornell() {
+  io::SceneDesc d = io::parseRayFile(testing::scenePath("cornell_box.ray"));
+  Loaded l;
+  l.scene = scene::Scene::build(d);
+  lights::addObjectLights(*l.scene, {});
+  lights::VplOptions v;
+  v.count = d.instantRadiosity->vpls.value_or(0);
+  lights::addVpls(*l.scene, v);
+  return l;
+}
+
+RenderResult renderWith(const scene::Scene& s, const lightcuts::LightEvaluator& ev, int w) {
+  RenderOptions o;
+  o.width = o.height = w;
+  return render(s, ev, o);
+}
+
+TEST(Accuracy, LightcutsWithinTwoPercentOfBruteForceOnTheCornellBox) {
+  Loaded l = loadCornell();
+  const scene::Scene& s = *l.scene;
+  ASSERT_GT(s.lights().size(), 8000u);
+  const int W = 40;
+  auto brute = lightcuts::makeBruteForce(s.lights());
+  lightcuts::LightForest forest = lightcuts::buildLightForest(s.lights());
+  auto lc = lightcuts::makeLightcuts(s.lights(), forest, lightcuts::CutOptions{});
+  RenderResult ref = renderWith(s, *brute, W);
+  RenderResult test = renderWith(s, *lc, W);
+  io::ImageMetrics m = io::compareImages(ref.image, test.image);
+  EXPECT_LE(m.fraction_over_2pct, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
+  // And it did so with far fewer lights than brute force.
+  double cut = double(test.stats.eval.cutNodes) / double(test.stats.eval.shadingPoints);
+  EXPECT_LT(cut, 0.1 * double(s.lights().size()));
+  // Walter's per-node rule alone is cheaper and less accurate: the reason for the default.
+  auto walter = lightcuts::makeLightcuts(s.lights(), forest,
+                                         lightcuts::CutOptions{0.02f, 1000, lightcuts::CutCriterion::Walter});
+  RenderResult w = renderWith(s, *walter, W);
+  EXPECT_LT(w.stats.eval.cutNodes, test.stats.eval.cutNodes);
+  EXPECT_GT(io::compareImages(ref.image, w.image).mean_relative_error, m.mean_relative_error);
+}
+
+}  // namespace
+}  // namespace lc::render
