@@ -58,3 +58,29 @@ TEST(Accuracy, LightcutsWithinTwoPercentOfBruteForceOnTheCornellBox) {
 
 }  // namespace
 }  // namespace lc::render
+
+namespace lc::render {
+namespace {
+
+TEST(Determinism, LightcutsImageIsTheSameAtOneAndTwoThreads) {
+  Loaded l = loadCornell();
+  lightcuts::LightForest forest = lightcuts::buildLightForest(l.scene->lights());
+  auto lc = lightcuts::makeLightcuts(l.scene->lights(), forest, lightcuts::CutOptions{});
+  RenderOptions o;
+  o.width = o.height = 24;
+  o.spp = 2;
+  o.threads = 1;
+  RenderResult a = render(*l.scene, *lc, o);
+  o.threads = 2;
+  RenderResult b = render(*l.scene, *lc, o);
+  for (size_t i = 0; i < a.image.pixels.size(); ++i) ASSERT_EQ(a.image.pixels[i], b.image.pixels[i]) << i;
+  // The tree (and its representatives) is the same when built again.
+  lightcuts::LightForest again = lightcuts::buildLightForest(l.scene->lights());
+  ASSERT_EQ(again.nodeCount(), forest.nodeCount());
+  for (size_t t = 0; t < forest.trees.size(); ++t)
+    for (size_t i = 0; i < forest.trees[t].nodes.size(); ++i)
+      ASSERT_EQ(forest.trees[t].nodes[i].rep, again.trees[t].nodes[i].rep);
+}
+
+}  // namespace
+}  // namespace lc::render
