@@ -276,6 +276,8 @@ std::vector<Row> catalogue() {
           "degenerate_cone.ray:2:1: error: cone has bottom_radius and top_radius both 0"),
       ray("degenerate_area_light", "area_light { u = (1,0,0); v = (2,0,0); }",
           "degenerate_area_light.ray:2:1: error: area_light has zero area (u and v are parallel or zero)"),
+      ray("area_light_overflow", "area_light { position = (3e38,0,0); u = (1e38,0,0); v = (0,1,0); }",
+          "area_light_overflow.ray:2:1: error: area_light corners are out of range for a float"),
       // ---- files
       ray("missing_obj", "obj_mesh { file = \"nothere.obj\"; }",
           "missing_obj.ray:2:1: error: cannot open OBJ file 'nothere.obj': No such file or directory"),

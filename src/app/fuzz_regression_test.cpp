@@ -78,4 +78,36 @@ TEST(FuzzRegression, SeedsLoad) {
   }
 }
 
+// The fixes for stb_image's bugs keep valid files decoding with the right values.
+TEST(FuzzRegression, SixteenBitPnmKeepsItsValues) {
+  lc::testing::TempDir dir;
+  // 2x1 grey, maxval 65535: 0x1234 and 0xFFFF (big-endian samples).
+  std::string pgm = std::string("P5\n2 1\n65535\n") + std::string("\x12\x34\xff\xff", 4);
+  std::ofstream(dir.file("g.pgm"), std::ios::binary) << pgm;
+  lc::io::Image g = lc::io::readImage(dir.file("g.pgm"));
+  ASSERT_EQ(g.width, 2);
+  ASSERT_EQ(g.height, 1);
+  EXPECT_FLOAT_EQ(g.pixels[0].x, float(0x1234) / 65535.0f);
+  EXPECT_FLOAT_EQ(g.pixels[0].z, float(0x1234) / 65535.0f);
+  EXPECT_FLOAT_EQ(g.pixels[1].y, 1.0f);
+  // 1x1 colour.
+  std::string ppm = std::string("P6\n1 1\n65535\n") + std::string("\x00\x00\x80\x00\xff\xff", 6);
+  std::ofstream(dir.file("c.ppm"), std::ios::binary) << ppm;
+  lc::io::Image c = lc::io::readImage(dir.file("c.ppm"));
+  EXPECT_FLOAT_EQ(c.pixels[0].x, 0.0f);
+  EXPECT_FLOAT_EQ(c.pixels[0].y, float(0x8000) / 65535.0f);
+  EXPECT_FLOAT_EQ(c.pixels[0].z, 1.0f);
+}
+
+TEST(FuzzRegression, RefusedFormatsSayWhy) {
+  lc::testing::TempDir dir;
+  std::ofstream(dir.file("x.gif"), std::ios::binary) << "GIF89a\x01\x00\x01\x00\x00\x00\x00;";
+  try {
+    lc::io::readImage(dir.file("x.gif"));
+    FAIL() << "a GIF was read";
+  } catch (const lc::Error& e) {
+    EXPECT_EQ(std::string(e.what()), "cannot read image '" + dir.file("x.gif") + "': GIF images are not supported");
+  }
+}
+
 }  // namespace

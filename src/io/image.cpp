@@ -15,10 +15,13 @@
 #include <cstddef>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "core/file_util.h"
 
@@ -149,6 +152,157 @@ std::string stbiReason() {
   return r ? r : "unknown error";
 }
 
+// stb_image 2.27 (Debian's libstb) writes past stbi__huffman::size[257] when the code counts
+// of a JPEG Huffman table (DHT) add up to more than 256, the format's maximum: found by the
+// image fuzz target (data/regressions/image/jpeg_dht_overflow.jpg). Such files are refused
+// before stb sees them. Every FF C4 byte pair in the file is read as the start of a DHT
+// segment the way stb reads one: a superset of the segments stb parses, wherever they are.
+std::vector<uint8_t> readAll(FILE* f) {
+  std::vector<uint8_t> b;
+  uint8_t buf[1 << 16];
+  size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) b.insert(b.end(), buf, buf + n);
+  std::rewind(f);
+  return b;
+}
+
+bool jpegHuffmanTablesValid(const std::vector<uint8_t>& b) {
+  for (size_t i = 0; i + 1 < b.size(); ++i) {
+    if (b[i] != 0xFF || b[i + 1] != 0xC4) continue;
+    size_t p = i + 2;
+    auto get8 = [&]() -> long { return p < b.size() ? b[p++] : 0; };  // stb reads 0 past the end
+    long len = get8() << 8;
+    len |= get8();
+    len -= 2;
+    while (len > 0 && p < b.size()) {
+      long q = get8();
+      if ((q >> 4) > 1 || (q & 15) > 3) break;  // stb stops with an error here
+      long count = 0;
+      for (int k = 0; k < 16; ++k) count += get8();
+      if (count > 256) return false;
+      p += size_t(count);
+      len -= 17 + count;
+    }
+  }
+  return true;
+}
+
+// stb_image 2.27 loops forever on a Radiance HDR whose run-length data has a zero count,
+// which every truncated RLE file reaches (stb reads 0 past the end): found by the image fuzz
+// target (data/regressions/image/hdr_rle_zero_count.hdr; CVE-2021-42715, fixed in 2.28).
+// This walks the file as stbi__hdr_load does (header, resolution line, RLE scanlines),
+// reading 0 past the end as stb does, and returns false when stb would not terminate.
+bool hdrDecodeTerminates(const std::vector<uint8_t>& b) {
+  size_t p = 0;
+  auto get8 = [&]() -> int { return p < b.size() ? b[p++] : 0; };
+  auto eof = [&] { return p >= b.size(); };
+  auto token = [&] {  // stbi__hdr_gettoken
+    std::string t;
+    char c = char(get8());
+    while (!eof() && c != '\n') {
+      t += c;
+      if (t.size() == 1023) {
+        while (!eof() && get8() != '\n') {
+        }
+        break;
+      }
+      c = char(get8());
+    }
+    return t;
+  };
+  std::string magic = token();
+  if (std::strcmp(magic.c_str(), "#?RADIANCE") != 0 && std::strcmp(magic.c_str(), "#?RGBE") != 0) return true;
+  bool valid = false;
+  for (;;) {
+    std::string t = token();
+    if (t.c_str()[0] == 0) break;
+    if (std::strcmp(t.c_str(), "FORMAT=32-bit_rle_rgbe") == 0) valid = true;
+  }
+  if (!valid) return true;  // stb refuses the file
+  std::string res = token();
+  const char* tok = res.c_str();
+  if (std::strncmp(tok, "-Y ", 3) != 0) return true;
+  char* end = nullptr;
+  const int height = int(std::strtol(tok + 3, &end, 10));
+  tok = end;
+  while (*tok == ' ') ++tok;
+  if (std::strncmp(tok, "+X ", 3) != 0) return true;
+  const int width = int(std::strtol(tok + 3, nullptr, 10));
+  if (width < 8 || width >= 32768 || height <= 0) return true;  // flat data: a fixed amount
+  for (int j = 0; j < height; ++j) {
+    int c1 = get8(), c2 = get8(), len = get8();
+    if (c1 != 2 || c2 != 2 || (len & 0x80)) return true;  // stb reads the rest flat
+    len = (len << 8) | get8();
+    if (len != width) return true;  // stb stops with an error
+    for (int k = 0; k < 4; ++k) {
+      int i = 0;
+      while (width - i > 0) {
+        int count = get8();
+        if (count > 128) {  // a run
+          get8();
+          count -= 128;
+          if (count > width - i) return true;
+        } else {  // a dump
+          if (count == 0) return false;
+          if (count > width - i) return true;
+          p += size_t(count);
+        }
+        i += count;
+      }
+    }
+  }
+  return true;
+}
+
+// Binary PNM with 16-bit samples (P5/P6, maxval > 255). stb_image 2.27 gets these wrong
+// twice: it converts them to the requested channel count as if they were 8-bit, returning a
+// buffer half the size it should be (a heap overflow when read: found by the image fuzz
+// target, data/regressions/image/pnm16_channel_conversion.pgm), and it does not swap the
+// big-endian samples. They are decoded here instead: value / maxval. Returns false (and
+// leaves the file to stb) when the header is not a 16-bit binary PNM header.
+bool readPnm16(const std::string& path, const std::vector<uint8_t>& b, bool srgb, uint64_t maxPixels,
+               Image& out) {
+  size_t p = 2;
+  auto isSpace = [](uint8_t c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; };
+  auto number = [&](uint64_t& v) {
+    for (;;) {  // whitespace and # comments
+      while (p < b.size() && isSpace(b[p])) ++p;
+      if (p < b.size() && b[p] == '#') {
+        while (p < b.size() && b[p] != '\n' && b[p] != '\r') ++p;
+        continue;
+      }
+      break;
+    }
+    if (p >= b.size() || b[p] < '0' || b[p] > '9') return false;
+    v = 0;
+    while (p < b.size() && b[p] >= '0' && b[p] <= '9') {
+      v = std::min<uint64_t>(v * 10 + uint64_t(b[p] - '0'), uint64_t(1) << 40);
+      ++p;
+    }
+    return true;
+  };
+  uint64_t w = 0, h = 0, maxval = 0;
+  if (!number(w) || !number(h) || !number(maxval)) return false;
+  if (maxval <= 255) return false;  // 8-bit: stb reads those correctly
+  if (p >= b.size() || !isSpace(b[p])) throwDecode(path, "bad PNM header");
+  ++p;  // exactly one whitespace character before the samples
+  if (maxval > 65535) throwDecode(path, "PNM maxval " + std::to_string(maxval) + " is more than 65535");
+  if (w == 0 || h == 0) throwDecode(path, "empty image");
+  if (w > uint64_t(1) << 24 || h > uint64_t(1) << 24) throwDecode(path, "image too large");
+  checkSize(path, int(w), int(h), maxPixels);
+  const size_t channels = b[1] == '5' ? 1 : 3;
+  const size_t need = size_t(w) * size_t(h) * channels * 2;
+  if (b.size() - p < need) throwDecode(path, "truncated PNM data");
+  out = Image(int(w), int(h));
+  for (size_t i = 0; i < out.pixels.size(); ++i)
+    for (size_t c = 0; c < 3; ++c) {
+      size_t k = p + 2 * (i * channels + (channels == 1 ? 0 : c));
+      float v = std::min(1.0f, float((unsigned(b[k]) << 8) | b[k + 1]) / float(maxval));
+      out.pixels[i][int(c)] = srgb ? srgbToLinear(v) : v;
+    }
+  return true;
+}
+
 struct StbiFree {
   void operator()(void* p) const { stbi_image_free(p); }
 };
@@ -242,6 +396,20 @@ Image readImage(const std::string& path, bool srgb, uint64_t maxPixels) {
     return readExr(path, maxPixels);
   }
 
+  // Formats outside the documented set are refused before stb_image: less decoder to trust.
+  if (got >= 4 && std::memcmp(magic, "GIF8", 4) == 0) throwDecode(path, "GIF images are not supported");
+  if (got >= 4 && std::memcmp(magic, "8BPS", 4) == 0) throwDecode(path, "PSD images are not supported");
+  if (got >= 4 && magic[0] == 0x53 && magic[1] == 0x80 && magic[2] == 0xF6 && magic[3] == 0x34)
+    throwDecode(path, "PIC images are not supported");
+  // stb takes FF (FF)* D8 as a JPEG start: any file that starts with FF is checked.
+  if (got >= 1 && magic[0] == 0xFF && !jpegHuffmanTablesValid(readAll(f.get())))
+    throwDecode(path, "corrupt JPEG (a Huffman table has more than 256 codes)");
+
+  if (got >= 2 && magic[0] == 'P' && (magic[1] == '5' || magic[1] == '6')) {
+    Image img;
+    if (readPnm16(path, readAll(f.get()), srgb, maxPixels, img)) return img;
+  }
+
   int w = 0, h = 0, comp = 0;
   if (!stbi_info_from_file(f.get(), &w, &h, &comp)) throwDecode(path, stbiReason());
   // stbi_info reports a top-down BMP's height as negative (as stored); the decoder flips it.
@@ -250,6 +418,7 @@ Image readImage(const std::string& path, bool srgb, uint64_t maxPixels) {
 
   // Ask for 3 channels: stb expands grey and drops alpha.
   if (stbi_is_hdr_from_file(f.get())) {
+    if (!hdrDecodeTerminates(readAll(f.get()))) throwDecode(path, "corrupt HDR (bad run-length data)");
     std::unique_ptr<float, StbiFree> data(stbi_loadf_from_file(f.get(), &w, &h, &comp, 3));
     if (!data) throwDecode(path, stbiReason());
     Image img(w, h);

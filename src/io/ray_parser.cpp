@@ -769,8 +769,16 @@ void Parser::areaLight(const Token& kw) {
     return true;
   });
   if (!haveU || !haveV) fail(kw, "area_light needs both u and v");
-  if (!(length(cross(u, v)) > 1e-6f * length(u) * length(v)))
-    fail(kw, "area_light has zero area (u and v are parallel or zero)");
+  {
+    // In double: float products of large or tiny edges would overflow or underflow.
+    double ux = u.x, uy = u.y, uz = u.z, vx = v.x, vy = v.y, vz = v.z;
+    double cx = uy * vz - uz * vy, cy = uz * vx - ux * vz, cz = ux * vy - uy * vx;
+    double area = std::sqrt(cx * cx + cy * cy + cz * cz);
+    double lu = std::sqrt(ux * ux + uy * uy + uz * uz), lv = std::sqrt(vx * vx + vy * vy + vz * vz);
+    if (!(area > 1e-6 * lu * lv)) fail(kw, "area_light has zero area (u and v are parallel or zero)");
+    if (!isFinite(corner + u) || !isFinite(corner + v) || !isFinite(corner + u + v))
+      fail(kw, "area_light corners are out of range for a float");
+  }
   checkMeshLimits(kw, 4, 2);
   MeshDesc mesh;
   mesh.points = {corner, corner + u, corner + u + v, corner + v};
