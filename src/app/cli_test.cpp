@@ -583,10 +583,10 @@ TEST(CliLimitsRender, ObjectLightsFromDensity) {
   writeText(dir.file("s.ray"), kHeader +
                                    "square { material = { luminosity = { density = 1e6; intensity = 1; }; }; }\n");
   CliResult bad = run({"info", "s.ray", "--max-lights", "1000"}, dir.path());
-  if (bad.err.find("not supported yet") != std::string::npos) GTEST_SKIP() << "object lights not implemented yet";
   EXPECT_EQ(bad.status, 1);
-  EXPECT_NE(bad.err.find("--max-lights"), std::string::npos) << bad.err;
-  EXPECT_NE(bad.err.find("s.ray:2:"), std::string::npos) << bad.err;
+  EXPECT_EQ(bad.err,
+            "lightcuts: s.ray:2:23: error: luminous objects need 2000000 lights (2000000 with the scene's "
+            "other lights), more than --max-lights (1000)\n");
   CliResult ok = run({"info", "s.ray", "--max-lights", "2000000"}, dir.path());
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
@@ -596,9 +596,10 @@ TEST(CliLimitsRender, VplsFromTheCommandLine) {
   TempDir dir;
   writeText(dir.file("s.ray"), kHeader + "point_light { position = (0,0,2); }\nsphere {}\n");
   CliResult bad = run({"info", "s.ray", "--vpls", "100", "--max-vpls", "10"}, dir.path());
-  if (bad.err.find("not supported yet") != std::string::npos) GTEST_SKIP() << "VPLs not implemented yet";
   EXPECT_EQ(bad.status, 1);
-  EXPECT_NE(bad.err.find("--max-vpls"), std::string::npos) << bad.err;
+  EXPECT_EQ(bad.err, "lightcuts: 100 VPL paths requested, more than --max-vpls (10)\n");
+  CliResult ok = run({"info", "s.ray", "--vpls", "100", "--max-vpls", "100"}, dir.path());
+  EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
 // ---------------------------------------------------------------------------------------
