@@ -48,8 +48,9 @@ FUZZ_TARGETS ?=
 fuzz: deps
 	@./scripts/fuzz.sh $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 
-report: build
-	@./$(BUILD)/lightcuts report -o docs/report.html
+# docs/BENCHMARKS.md (written by `make bench`) as one self-contained HTML page, images inlined.
+report:
+	@/usr/bin/python3 scripts/report.py -i docs/BENCHMARKS.md -o docs/report.html
 
 clean:
 	rm -rf $(BUILD) build-sanitize build-fuzz
