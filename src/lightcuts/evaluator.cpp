@@ -119,6 +119,7 @@ class Lightcuts final : public LightEvaluator {
       if (b > 0) {
         // A node in the heap may be refined next: fetch its children while we work.
         __builtin_prefetch(&tree.nodes[n.left]);
+        __builtin_prefetch(&tree.nodes[n.left + 1]);
         float spread = visible ? std::max(0.0f, b - luminance(lower)) : b;
         sumSq += double(spread) * spread;
         heap.push_back(Entry{b, uint32_t(nodes.size()), spread});
