@@ -152,11 +152,6 @@ std::string stbiReason() {
   return r ? r : "unknown error";
 }
 
-// stb_image 2.27 (Debian's libstb) writes past stbi__huffman::size[257] when the code counts
-// of a JPEG Huffman table (DHT) add up to more than 256, the format's maximum: found by the
-// image fuzz target (data/regressions/image/jpeg_dht_overflow.jpg). Such files are refused
-// before stb sees them. Every FF C4 byte pair in the file is read as the start of a DHT
-// segment the way stb reads one: a superset of the segments stb parses, wherever they are.
 std::vector<uint8_t> readAll(FILE* f) {
   std::vector<uint8_t> b;
   uint8_t buf[1 << 16];
@@ -166,25 +161,179 @@ std::vector<uint8_t> readAll(FILE* f) {
   return b;
 }
 
-bool jpegHuffmanTablesValid(const std::vector<uint8_t>& b) {
+// JPEG files are checked before stb_image 2.27 (Debian's libstb) sees them, for two bugs
+// the image fuzz target found (data/regressions/image/jpeg_*):
+//  - a Huffman table (DHT) whose code counts add up to more than 256 makes it write past
+//    stbi__huffman::size[257]; one with 256 codes of at most 9 bits makes the slow decode
+//    path index values[] with a negative symbol id;
+//  - a scan (SOS) that uses a Huffman table no DHT defined makes it decode with
+//    uninitialised memory (it mallocs its state without clearing it): reads far out of
+//    bounds.
+// The walk follows stb's own (stbi__decode_jpeg_header, stbi__decode_jpeg_image): fill
+// bytes, junk between segments before the frame header, 0 read past the end. Entropy-coded
+// data is skipped to the next FF xx that is not a stuffed 00, a fill FF or a restart
+// marker: stb either stops at that same marker or ends the image earlier, so every DHT and
+// SOS it acts on is one the walk checks. Returns the reason to refuse the file, or "".
+// Besides the walk, every FF C4 in the file is checked as a DHT (cheap, and independent of
+// the walk's reading of the structure).
+std::string jpegProblem(const std::vector<uint8_t>& b) {
+  auto tableProblem = [](const int* counts) -> const char* {
+    int n = 0, short9 = 0;
+    for (int i = 0; i < 16; ++i) {
+      n += counts[i];
+      if (i < 9) short9 += counts[i];
+    }
+    if (n > 256) return "corrupt JPEG (a Huffman table has more than 256 codes)";
+    if (n == 256 && short9 == 256) return "corrupt JPEG (a Huffman table has 256 codes of at most 9 bits)";
+    return nullptr;
+  };
   for (size_t i = 0; i + 1 < b.size(); ++i) {
     if (b[i] != 0xFF || b[i + 1] != 0xC4) continue;
-    size_t p = i + 2;
-    auto get8 = [&]() -> long { return p < b.size() ? b[p++] : 0; };  // stb reads 0 past the end
-    long len = get8() << 8;
-    len |= get8();
-    len -= 2;
-    while (len > 0 && p < b.size()) {
-      long q = get8();
-      if ((q >> 4) > 1 || (q & 15) > 3) break;  // stb stops with an error here
-      long count = 0;
-      for (int k = 0; k < 16; ++k) count += get8();
-      if (count > 256) return false;
-      p += size_t(count);
-      len -= 17 + count;
+    size_t q = i + 2;
+    auto at = [&](size_t k) -> int { return k < b.size() ? b[k] : 0; };
+    long len = (at(q) << 8) + at(q + 1) - 2;
+    q += 2;
+    while (len > 0 && q < b.size()) {
+      if ((at(q) >> 4) > 1 || (at(q) & 15) > 3) break;
+      int counts[16], n = 0;
+      for (int k = 0; k < 16; ++k) n += counts[k] = at(q + 1 + size_t(k));
+      if (const char* why = tableProblem(counts)) return why;
+      q += 17 + size_t(n);
+      len -= 17 + n;
     }
   }
-  return true;
+
+  size_t p = 0;
+  auto eof = [&] { return p >= b.size(); };
+  auto get8 = [&]() -> int { return p < b.size() ? b[p++] : 0; };
+  auto get16 = [&] {
+    int hi = get8();
+    return (hi << 8) + get8();
+  };
+  auto skip = [&](long n) { p = n > 0 ? std::min(b.size(), p + size_t(n)) : p; };
+  constexpr int kNone = 0xFF;
+  auto marker = [&]() -> int {  // stbi__get_marker
+    int x = get8();
+    if (x != 0xFF) return kNone;
+    while (x == 0xFF) x = get8();
+    return x;
+  };
+  bool dcDefined[4] = {false, false, false, false}, acDefined[4] = {false, false, false, false};
+  std::string problem;
+  // stbi__process_marker: false when stb fails (the image ends there).
+  auto processMarker = [&](int m) -> bool {
+    if (m == 0xDD) {  // DRI
+      if (get16() != 4) return false;
+      get16();
+      return true;
+    }
+    if (m == 0xDB) {  // DQT
+      long len = get16() - 2;
+      while (len > 0) {
+        int q = get8(), pq = q >> 4, t = q & 15;
+        if ((pq != 0 && pq != 1) || t > 3) return false;
+        skip(pq ? 128 : 64);
+        len -= pq ? 129 : 65;
+      }
+      return len == 0;
+    }
+    if (m == 0xC4) {  // DHT
+      long len = get16() - 2;
+      while (len > 0) {
+        int q = get8(), tc = q >> 4, th = q & 15;
+        if (tc > 1 || th > 3) return false;
+        int counts[16], n = 0;
+        for (int k = 0; k < 16; ++k) n += counts[k] = get8();
+        if (const char* why = tableProblem(counts)) {
+          problem = why;
+          return false;
+        }
+        (tc == 0 ? dcDefined : acDefined)[th] = true;
+        skip(n);
+        len -= 17 + n;
+      }
+      return len == 0;
+    }
+    if ((m >= 0xE0 && m <= 0xEF) || m == 0xFE) {  // APPn, COM
+      int len = get16();
+      if (len < 2) return false;
+      skip(len - 2);
+      return true;
+    }
+    return false;
+  };
+
+  if (marker() != 0xD8) return "";  // not a JPEG to stb
+  int m = marker();
+  while (!(m == 0xC0 || m == 0xC1 || m == 0xC2)) {
+    if (!processMarker(m)) return problem;
+    m = marker();
+    while (m == kNone) {
+      if (eof()) return problem;
+      m = marker();
+    }
+  }
+  const bool progressive = m == 0xC2;
+  // Frame header (stbi__process_frame_header): the component ids.
+  int lf = get16();
+  get8();
+  get16();
+  get16();
+  int nComp = get8();
+  if (nComp != 1 && nComp != 3 && nComp != 4) return problem;
+  if (lf != 8 + 3 * nComp) return problem;
+  int ids[4];
+  for (int i = 0; i < nComp; ++i) {
+    ids[i] = get8();
+    get8();
+    get8();
+  }
+  m = marker();
+  while (m != 0xD9) {
+    if (m == 0xDA) {  // SOS (stbi__process_scan_header)
+      int ls = get16(), nScan = get8();
+      if (nScan < 1 || nScan > 4 || nScan > nComp || ls != 6 + 2 * nScan) return problem;
+      int hd[4], ha[4];
+      for (int i = 0; i < nScan; ++i) {
+        int id = get8(), q = get8(), which = 0;
+        while (which < nComp && ids[which] != id) ++which;
+        if (which == nComp) return problem;
+        hd[i] = q >> 4;
+        ha[i] = q & 15;
+        if (hd[i] > 3 || ha[i] > 3) return problem;
+      }
+      int specStart = get8(), specEnd = get8(), aa = get8(), succHigh = aa >> 4, succLow = aa & 15;
+      if (progressive) {
+        if (specStart > 63 || specEnd > 63 || specStart > specEnd || succHigh > 13 || succLow > 13) return problem;
+      } else if (specStart != 0 || succHigh != 0 || succLow != 0) {
+        return problem;
+      }
+      for (int i = 0; i < nScan; ++i) {
+        bool needDc = progressive ? specStart == 0 && succHigh == 0 : true;
+        bool needAc = progressive ? specStart != 0 : true;
+        if ((needDc && !dcDefined[hd[i]]) || (needAc && !acDefined[ha[i]]))
+          return "corrupt JPEG (a scan uses a Huffman table that is not defined)";
+      }
+      // Entropy-coded data: to the next FF xx that is a marker.
+      m = -1;
+      while (p < b.size() && m < 0) {
+        if (b[p++] != 0xFF) continue;
+        int x = get8();
+        while (x == 0xFF) x = get8();
+        if (x != 0 && !(x >= 0xD0 && x <= 0xD7)) m = x;
+      }
+      if (m < 0) return problem;  // end of file
+      continue;
+    }
+    if (m == 0xDC) {  // DNL
+      if (get16() != 4) return problem;
+      get16();
+    } else if (!processMarker(m)) {
+      return problem;
+    }
+    m = marker();
+  }
+  return problem;
 }
 
 // stb_image 2.27 loops forever on a Radiance HDR whose run-length data has a zero count,
@@ -402,8 +551,10 @@ Image readImage(const std::string& path, bool srgb, uint64_t maxPixels) {
   if (got >= 4 && magic[0] == 0x53 && magic[1] == 0x80 && magic[2] == 0xF6 && magic[3] == 0x34)
     throwDecode(path, "PIC images are not supported");
   // stb takes FF (FF)* D8 as a JPEG start: any file that starts with FF is checked.
-  if (got >= 1 && magic[0] == 0xFF && !jpegHuffmanTablesValid(readAll(f.get())))
-    throwDecode(path, "corrupt JPEG (a Huffman table has more than 256 codes)");
+  if (got >= 1 && magic[0] == 0xFF) {
+    std::string why = jpegProblem(readAll(f.get()));
+    if (!why.empty()) throwDecode(path, why);
+  }
 
   if (got >= 2 && magic[0] == 'P' && (magic[1] == '5' || magic[1] == '6')) {
     Image img;
