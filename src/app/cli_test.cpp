@@ -384,6 +384,15 @@ std::vector<Row> catalogue() {
                      {"--max-nesting", "2"}));
   rows.push_back(ray("limit_image_pixels", "sphere {}", "an image of 100x100 exceeds --max-image-pixels (1000)",
                      {"--width", "100", "--height", "100", "--max-image-pixels", "1000"}));
+  rows.push_back(ray("limit_objects", "sphere {} sphere {} sphere {}",
+                     "limit_objects.ray:2:21: error: more objects and materials than the limit of 3 (raise it with --max-objects)",
+                     {"--max-objects", "3"}));
+  {
+    Row r = ray("output_without_extension", "sphere {}",
+                "cannot write 'out': no file extension to choose the format (use .png, .ppm, .bmp or .exr)");
+    r.args = {"render", "output_without_extension.ray", "-o", "out", "-q"};
+    rows.push_back(r);
+  }
   return rows;
 }
 

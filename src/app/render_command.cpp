@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <filesystem>
 #include <thread>
 #include <nlohmann/json.hpp>
 
@@ -66,6 +67,9 @@ int runRender(RenderArgs& a) {
   auto t0 = std::chrono::steady_clock::now();
   if (a.out.empty()) a.out = defaultOutput(a.scene);
   std::string ext = fileExtension(a.out);
+  if (std::filesystem::is_directory(a.out)) throw Error("cannot write '" + a.out + "': it is a directory");
+  if (ext.empty())
+    throw Error("cannot write '" + a.out + "': no file extension to choose the format (use .png, .ppm, .bmp or .exr)");
   if (!io::isWritableImageExtension(ext))
     throw Error("cannot write '" + a.out + "': unknown image format '." + ext + "' (use .png, .ppm, .bmp or .exr)");
   // Fail before a long render, not after it.

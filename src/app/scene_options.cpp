@@ -33,6 +33,7 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
   c.add_option_function<uint64_t>("--max-triangles", [&o](const uint64_t& v) { o.limits.maxTriangles = o.limits.maxVertices = v; },
                                   "Limit on triangles (and vertices) in all meshes");
   c.add_option("--max-nesting", o.limits.maxNesting, "Limit on nested transforms and groups in .ray files");
+  c.add_option("--max-objects", o.limits.maxObjects, "Limit on primitives and materials in a .ray file");
   c.add_option("--max-image-pixels", o.limits.maxImagePixels, "Limit on width x height");
   c.add_option("--max-texture-pixels", o.limits.maxTexturePixels, "Limit on the pixels of one texture");
 }

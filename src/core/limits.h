@@ -14,6 +14,7 @@ struct Limits {
   uint64_t maxImagePixels = 100'000'000;   // --max-image-pixels: width * height
   uint64_t maxTexturePixels = 268'435'456; // --max-texture-pixels: per texture (16384^2)
   int maxNesting = 1000;                // --max-nesting: nested transforms/groups/comments
+  uint64_t maxObjects = 5'000'000;      // --max-objects: primitives and materials in a .ray file
   uint64_t maxVpls = 10'000'000;        // --max-vpls
   uint64_t maxFileBytes = 2'000'000'000;  // scene/OBJ file size
 };

@@ -100,6 +100,12 @@ class Parser {
  private:
   // ---- errors -------------------------------------------------------------------------
   [[noreturn]] void fail(const Token& t, const std::string& msg) const { throw Error(lex_.loc(t), msg); }
+  // Objects and materials cost memory per item whatever their text: bound their number.
+  void checkItemLimit(const Token& at) const {
+    if (scene_.objects.size() + scene_.materials.size() >= opt_.limits.maxObjects)
+      fail(at, "more objects and materials than the limit of " + std::to_string(opt_.limits.maxObjects) +
+                   " (raise it with --max-objects)");
+  }
   [[noreturn]] void expected(const std::string& what, const Token& got) const {
     fail(got, "expected " + what + ", got " + got.describe());
   }
@@ -459,6 +465,7 @@ int Parser::materialValue(int baseIndex) {
 //   name x | name = "x"     declares the material for later `material = x`
 //   luminosity = { ... }    makes objects with this material lights (see luminosity())
 int Parser::materialBlock(int baseIndex) {
+  checkItemLimit(lex_.peek());
   MaterialDesc m = scene_.materials[size_t(baseIndex)];
   m.name.clear();
   m.loc = lex_.loc(lex_.peek());
@@ -754,6 +761,7 @@ void Parser::light(const Token& kw) {
 // is a copy of the current default with diffuse 0 and
 // luminosity { colour = the colour; intensity = 1; density = 1 }.
 void Parser::areaLight(const Token& kw) {
+  checkItemLimit(kw);
   Vec3 corner(0, 0, 0), u, v;
   Color colour(1, 1, 1);
   bool haveU = false, haveV = false;
@@ -977,6 +985,7 @@ Mat4 Parser::transformArgs(const Token& kw) {
 //             capped (true); the radii must not both be 0
 //   trimesh / polymesh, obj_mesh: see trimesh() and objMesh()
 void Parser::primitive(const Token& kw) {
+  checkItemLimit(kw);
   ObjectDesc obj;
   obj.transform = currentTransform();
   obj.material = defaultMat_;
