@@ -107,7 +107,8 @@ int runRender(RenderArgs& a) {
                             a.load.limits.maxImagePixels));
   scene.setCamera(scene::Camera::fromDesc(cam, float(a.width) / float(a.height)));
 
-  // Light tree and evaluator.
+  // Light tree and evaluator; oriented lights weigh their normal cones by the scene's size.
+  tb.sceneDiagonal = scene.bounds().diagonal();
   lightcuts::LightForest forest;
   std::unique_ptr<lightcuts::LightEvaluator> evaluator;
   lightcuts::CutOptions co{error, a.maxCut, lightcuts::parseCutCriterion(a.criterion)};

@@ -152,9 +152,12 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
       // c weights the normal cone for lights whose emission depends on direction.
       float c = 0;
       if (k.type == LightType::Oriented || k.type == LightType::Spot) {
-        Bounds3 b;
-        for (uint32_t li : idx) b.extend(lights.lights[li].position);
-        c = b.diagonal();
+        c = options.sceneDiagonal;
+        if (!(c > 0)) {
+          Bounds3 b;
+          for (uint32_t li : idx) b.extend(lights.lights[li].position);
+          c = b.diagonal();
+        }
       }
       t = buildAgglomerativeTree(lights, idx, k.type, c, seed, std::max<size_t>(options.exactLimit, 2));
       computeSeedData(lights, t);

@@ -57,6 +57,9 @@ struct TreeBuildOptions {
   // Agglomerative: light sets up to this size are clustered exactly (greedy); larger ones
   // bottom-up in Morton-ordered groups first (see agglomerative_build.cpp).
   size_t exactLimit = 8192;
+  // c of the metric for oriented and spot lights: the scene's diagonal (Walter et al.). 0 =
+  // the diagonal of the tree's own lights (for callers that know no scene).
+  float sceneDiagonal = 0;
 };
 
 struct LightForest {
