@@ -216,8 +216,8 @@ class SeedCuts final : public LightEvaluator {
 
  private:
   // The contribution of a node's light: the light itself at a leaf, the synthetic
-  // centroid light otherwise. `blocked` is set when an inner node's light is non-zero but
-  // fully occluded.
+  // centroid light otherwise (its visibility measured toward the node's representative
+  // light). `blocked` is set when an inner node's light is non-zero but fully occluded.
   Color nodeLight(const LightTree& tree, const LightGroup& g, uint32_t ni, const ShadingPoint& sp,
                   Visibility& vis, EvalStats& stats, bool& blocked) const {
     const LightNode& n = tree.nodes[ni];
@@ -233,8 +233,15 @@ class SeedCuts final : public LightEvaluator {
     Vec3 wi;
     float dist;
     if (!lightContribution(syn, g, sp, mg, wi, dist)) return Color(0);
+    // The averaged light can lie inside a closed emitter (the centre of a glowing sphere),
+    // where every shadow ray toward it is blocked by the emitter itself; its visibility is
+    // taken toward the cluster's representative light instead, a point on a real emitter.
+    const Light& rep = lights_.lights[n.rep];
+    Vec3 repDir = tree.type == LightType::Directional ? -rep.direction : rep.position - sp.p;
+    float repDist = tree.type == LightType::Directional ? kInf : length(repDir);
+    if (!(repDist > 0)) return mg * n.intensity;
     ++stats.shadowRays;
-    Color v = vis(wi, dist);
+    Color v = vis(tree.type == LightType::Directional ? repDir : repDir / repDist, repDist);
     blocked = isBlack(v);
     return mg * v * n.intensity;
   }

@@ -158,17 +158,27 @@ TEST(SeedCuts, BlockedRepresentativeFallsBackToChildren) {
     s.lights.push_back(l);
   }
   LightForest f = buildLightForest(s, TreeBuildOptions{TreeBuilder::Seed, 1});
-  // The centroid (0,5,0) is straight up and blocked; the child at x = +1 is visible.
-  struct BlockUp : Visibility {
-    Color operator()(const Vec3& wi, float) override { return std::fabs(wi.x) < 1e-3f ? Color(0) : Color(1); }
+  // The centroid light's visibility is taken toward the root's representative light:
+  // block exactly that light; the other child is visible.
+  float blockedX = s.lights[f.trees[0].nodes[0].rep].position.x;
+  struct BlockOne : Visibility {
+    float x;
+    Color operator()(const Vec3& wi, float) override { return wi.x * x > 0 ? Color(0) : Color(1); }
   } vis;
+  vis.x = blockedX;
   auto seed = makeSeedCuts(s, f, CutOptions{10.0f, 1000});
   EvalStats st;
   ShadingPoint sp = point(Vec3(0, 0, 0));
   sp.ks = Color(0);
   EvalResult r = seed->evaluate(sp, vis, st);
-  EXPECT_EQ(r.cutSize, 2u);
-  EXPECT_GT(luminance(r.radiance), 0.0f);
+  EXPECT_EQ(r.cutSize, 2u);  // the two children replaced the blocked centroid light
+  // Exactly the visible light's contribution.
+  Color mg;
+  Vec3 wi;
+  float d;
+  const Light& visible = s.lights[blockedX < 0 ? 1 : 0];
+  ASSERT_TRUE(lightContribution(visible, s.groups[0], sp, mg, wi, d));
+  EXPECT_NEAR(luminance(r.radiance), luminance(mg * visible.intensity), 1e-6f);
 }
 
 TEST(Methods, ParseNames) {
