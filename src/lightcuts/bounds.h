@@ -56,19 +56,17 @@ inline float cosLowerBoundBox(const Frame& f, const Vec3& lo, const Vec3& hi) {
 }
 
 // Narrows a cosine lower bound by a cone of half-angle beta: cos(theta + beta), 0 past 90.
-inline float coneNarrow(float cosTheta, float cosBeta) {
+inline float coneNarrow(float cosTheta, float cosBeta, float sinBeta) {
   if (cosBeta <= 0 || cosTheta <= 0) return 0;
   float sinTheta = std::sqrt(std::max(0.0f, 1 - cosTheta * cosTheta));
-  float sinBeta = std::sqrt(std::max(0.0f, 1 - cosBeta * cosBeta));
   return std::max(0.0f, cosTheta * cosBeta - sinTheta * sinBeta);
 }
 
 // Widens a cosine bound by a cone of half-angle beta: directions within beta of the axis
 // can be up to beta closer to the target. cos(theta - beta) when theta > beta, else 1.
-inline float coneWiden(float cosTheta, float cosBeta) {
+inline float coneWiden(float cosTheta, float cosBeta, float sinBeta) {
   if (cosBeta <= -1.0f || cosTheta >= cosBeta) return 1.0f;
   float sinTheta = std::sqrt(std::max(0.0f, 1 - cosTheta * cosTheta));
-  float sinBeta = std::sqrt(std::max(0.0f, 1 - cosBeta * cosBeta));
   return std::min(1.0f, cosTheta * cosBeta + sinTheta * sinBeta);
 }
 
@@ -148,12 +146,12 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
       float up = pc + ph;
       float cosUp = up <= 0 ? 0.0f : (dMin > 0 ? std::min(1.0f, up / dMin) : 1.0f);
       // The slack only rounds a positive bound up: a zero bound is exact (nothing reaches).
-      float cUp = coneWiden(cosUp, node.cosHalfAngle);
+      float cUp = coneWiden(cosUp, node.cosHalfAngle, node.sinHalfAngle);
       if (cUp > 0) cUp = std::min(1.0f, cUp + kSlack);
       gUp *= type == LightType::Oriented ? cUp : g.falloff(cUp);
       if (lower) {
         // 0 means "may be 90 degrees or more", not a cosine: no lower bound then.
-        float cLo = dMax > 0 ? coneNarrow(std::max(0.0f, (pc - ph) / dMax), node.cosHalfAngle) : 0.0f;
+        float cLo = dMax > 0 ? coneNarrow(std::max(0.0f, (pc - ph) / dMax), node.cosHalfAngle, node.sinHalfAngle) : 0.0f;
         gLo *= cLo <= 0 ? 0.0f : (type == LightType::Oriented ? cLo : g.falloff(cLo));
       }
     }

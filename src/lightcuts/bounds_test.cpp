@@ -90,7 +90,7 @@ Config randomConfig(Rng& r, LightType type) {
   nd.intensity = acc.intensity;
   nd.rep = acc.rep;
   nd.left = 1;
-  nd.count = uint32_t(n);
+  nd.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - acc.cosHalfAngle * acc.cosHalfAngle));
 
   ShadingPoint& sp = c.sp;
   sp.p = r.below(5) == 0 ? centre : Vec3(6 * r.uniform() - 3, 6 * r.uniform() - 3, 6 * r.uniform() - 3);
@@ -165,10 +165,10 @@ TEST(CosBoundBox, IsTightForAPointOnTheAxis) {
 }
 
 TEST(ConeWiden, WidensByTheHalfAngle) {
-  float c = coneWiden(std::cos(1.0f), std::cos(0.25f));
+  float c = coneWiden(std::cos(1.0f), std::cos(0.25f), std::sin(0.25f));
   EXPECT_NEAR(c, std::cos(0.75f), 1e-5f);
-  EXPECT_EQ(coneWiden(0.9f, 0.5f), 1.0f);
-  EXPECT_EQ(coneWiden(-0.5f, -1.0f), 1.0f);
+  EXPECT_EQ(coneWiden(0.9f, 0.5f, std::sqrt(0.75f)), 1.0f);
+  EXPECT_EQ(coneWiden(-0.5f, -1.0f, 0.0f), 1.0f);
 }
 
 TEST(ConeUnion, ContainsBothCones) {

@@ -2,6 +2,8 @@
 // as LightNodes (children adjacent, parents before children).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -72,6 +74,7 @@ inline Cluster mergeClusters(const Cluster& a, const Cluster& b, int32_t ia, int
 inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, LightTree& tree) {
   tree.nodes.clear();
   tree.nodes.reserve(clusters.size());
+  tree.counts.assign(clusters.size(), 0);
   tree.nodes.push_back(LightNode{});
   std::vector<std::pair<int32_t, uint32_t>> stack{{root, 0u}};
   while (!stack.empty()) {
@@ -85,7 +88,9 @@ inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, Light
     n.cosHalfAngle = c.cosHalfAngle;
     n.intensity = c.intensity;
     n.rep = c.rep;
-    n.count = c.count;
+    n.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - c.cosHalfAngle * c.cosHalfAngle));
+    if (ni >= tree.counts.size()) tree.counts.resize(ni + 1, 0);
+    tree.counts[ni] = c.count;
     n.left = 0;
     if (c.left >= 0) {
       uint32_t j = uint32_t(tree.nodes.size());
@@ -96,6 +101,7 @@ inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, Light
       stack.emplace_back(c.left, j);
     }
   }
+  tree.counts.resize(tree.nodes.size());
 }
 
 }  // namespace lc::lightcuts::detail

@@ -29,7 +29,7 @@ struct LightNode {
   Color intensity;      // summed RGB intensity of the cluster
   uint32_t rep;         // representative light (index into LightSet::lights)
   uint32_t left;        // first child (the second is left + 1); 0 = leaf
-  uint32_t count;       // lights in the cluster
+  float sinHalfAngle;   // sqrt(1 - cosHalfAngle^2), kept so the bounds need no square root
   bool isLeaf() const { return left == 0; }
 };
 static_assert(sizeof(LightNode) == 64, "LightNode should fill one cache line");
@@ -47,6 +47,7 @@ struct LightTree {
   uint16_t group = 0;
   std::vector<LightNode> nodes;  // nodes[0] is the root
   std::vector<SeedNodeData> seed;  // parallel to nodes
+  std::vector<uint32_t> counts;    // parallel to nodes: lights in each cluster
 };
 
 enum class TreeBuilder { Agglomerative, Seed };
