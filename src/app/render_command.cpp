@@ -38,7 +38,7 @@ struct RenderArgs {
   std::string method = "lightcuts";
   std::string tree;  // default: by method
   float error = -1;  // default: by method
-  int maxCut = 1000;
+  int maxCut = 4000;
   std::string criterion = "total";
   std::string cutHeatmap;
   int referencePixels = 0;
@@ -285,7 +285,7 @@ void addRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"walter", "agglomerative", "seed"}));
   c->add_option("--error", a->error, "Error threshold: relative bound for lightcuts (default 0.02); radius/distance for seed (default 0.25)")
       ->check(CLI::Range(0.0, 1e6));
-  c->add_option("--max-cut", a->maxCut, "Most nodes in one cut")->check(CLI::Range(1, 1 << 30));
+  c->add_option("--max-cut", a->maxCut, "Most nodes in one cut (default 4000)")->check(CLI::Range(1, 1 << 30));
   c->add_option("--cut-criterion", a->criterion,
                 "When a lightcut stops: total (every bound and their root-sum-square below error x estimate, default) "
                 "or walter (every bound below error x estimate, as published)")

@@ -29,7 +29,7 @@ const char* methodName(Method m);
 //     et al. 2005). The errors of many nodes near the threshold add up, so the total
 //     error is often a few times errorRatio.
 //   Total: the same, and also the root-sum-square of the nodes' error spreads is below
-//     2 x errorRatio times the estimate. A node's spread is its upper bound, or, when
+//     1.75 x errorRatio times the estimate. A node's spread is its upper bound, or, when
 //     its representative is visible, its upper minus its lower bound (what the estimate
 //     of an unoccluded cluster can be off by). The errors of a cut have random signs, so
 //     this keeps the total error, not just each node's, near errorRatio.
@@ -39,7 +39,7 @@ const char* cutCriterionName(CutCriterion c);
 
 struct CutOptions {
   float errorRatio = 0.02f;  // --error: relative error threshold
-  int maxCut = 1000;         // --max-cut: most nodes in one cut
+  int maxCut = 4000;         // --max-cut: most nodes in one cut
   CutCriterion criterion = CutCriterion::Total;
 };
 
