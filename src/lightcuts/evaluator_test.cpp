@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <queue>
+#include <utility>
+
 #include "core/error.h"
 #include "core/rng.h"
+#include "lightcuts/bounds.h"
 
 namespace lc::lightcuts {
 namespace {
@@ -133,6 +137,54 @@ TEST_P(CutMethods, ErrorStaysNearTheThresholdAndCutsAreSmall) {
 
 INSTANTIATE_TEST_SUITE_P(Kinds, CutMethods, ::testing::Values(LightType::Omni, LightType::Oriented),
                          [](const auto& info) { return std::string(lightTypeName(info.param)); });
+
+// With no threshold a cut grows to --max-cut by always refining the node with the largest
+// bound: replaying that greedy order with std::priority_queue must give the same cut (this
+// checks the evaluator's own heap and its keys).
+TEST(Lightcuts, RefinesTheLargestBoundFirst) {
+  LightSet s = cloud(2000, LightType::Oriented, 6);
+  LightForest f = buildLightForest(s);
+  ASSERT_EQ(f.trees.size(), 1u);
+  const LightTree& t = f.trees[0];
+  const LightGroup& g = s.groups[0];
+  Unoccluded vis;
+  ShadingPoint sp = point(Vec3(0.3f, 0, -0.2f));
+  BoundFrames fr(sp);
+  auto unit = [&](uint32_t ni) {
+    Color mg;
+    Vec3 wi;
+    float d;
+    return lightContribution(s.lights[t.nodes[ni].rep], g, sp, mg, wi, d) ? mg : Color(0);
+  };
+  for (uint32_t maxCut : {1u, 2u, 17u, 100u, 333u, 1500u}) {
+    std::priority_queue<std::pair<float, uint32_t>> heap;
+    Color expect(0);
+    uint32_t size = 0;
+    auto add = [&](uint32_t ni) {
+      ++size;
+      const LightNode& n = t.nodes[ni];
+      float b = n.isLeaf() ? 0.0f : luminance(clusterBound(n, t.type, g, sp, fr));
+      if (b > 0)
+        heap.push({b, ni});
+      else
+        expect += unit(ni) * n.intensity;
+    };
+    add(0);
+    while (!heap.empty() && size < maxCut) {
+      uint32_t ni = heap.top().second;
+      heap.pop();
+      --size;
+      add(t.nodes[ni].left);
+      add(t.nodes[ni].left + 1);
+    }
+    for (; !heap.empty(); heap.pop()) expect += unit(heap.top().second) * t.nodes[heap.top().second].intensity;
+    auto lcut = makeLightcuts(s, f, CutOptions{0.0f, int(maxCut), CutCriterion::Walter});
+    EvalStats st;
+    EvalResult r = lcut->evaluate(sp, vis, st);
+    EXPECT_EQ(r.cutSize, size) << "max cut " << maxCut;
+    EXPECT_NEAR(luminance(r.radiance), luminance(expect), 1e-5f * luminance(expect)) << "max cut " << maxCut;
+  }
+}
 
 TEST(SeedCuts, ZeroThresholdReachesEveryLight) {
   LightSet s = cloud(200, LightType::Omni, 5);
