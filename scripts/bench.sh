@@ -8,16 +8,5 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 pkgs=(python3 python3-numpy python3-matplotlib python3-pil imagemagick)
-missing=()
-for p in "${pkgs[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "bench: installing ${missing[*]}" >&2
-  SUDO=""
-  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update
-  $SUDO apt-get install -y --no-install-recommends "${missing[@]}"
-fi
+scripts/install-deps.sh "${pkgs[@]}"
 exec /usr/bin/python3 scripts/bench.py --build "${BUILD:-build}" "$@"

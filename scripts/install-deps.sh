@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages lightcuts builds with, only when one is missing.
 # Idempotent: a second run with everything present touches nothing.
+#   scripts/install-deps.sh            # the build's packages (below)
+#   scripts/install-deps.sh PKG ...    # these packages instead (bench.sh, fuzz.sh)
 set -euo pipefail
 pkgs=(
   build-essential cmake pkg-config
@@ -15,6 +17,7 @@ pkgs=(
   libgtest-dev         # GoogleTest: the test suite
   libbenchmark-dev     # Google Benchmark: micro benchmarks under bench/
 )
+if [ $# -gt 0 ]; then pkgs=("$@"); fi
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -29,21 +29,12 @@
 
 namespace fs = std::filesystem;
 using lc::testing::TempDir;
+using lc::testing::binary;
+using lc::testing::slurp;
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::string binary() {
-  if (const char* b = std::getenv("LC_BINARY")) return b;
-  // Run by hand: the binary sits beside the test executable in the build directory.
-  return (fs::read_symlink("/proc/self/exe").parent_path() / "lightcuts").string();
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 void writeText(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);

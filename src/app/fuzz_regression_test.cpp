@@ -15,6 +15,7 @@
 #include "test_util.h"
 
 namespace fs = std::filesystem;
+using lc::testing::slurp;
 
 namespace {
 
@@ -26,11 +27,6 @@ std::vector<std::string> inputsOf(const std::string& target) {
     if (e.is_regular_file() && e.path().filename().string() != "README.md") files.push_back(e.path().string());
   std::sort(files.begin(), files.end());
   return files;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 template <class Fn>

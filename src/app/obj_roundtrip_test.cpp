@@ -25,20 +25,11 @@
 namespace fs = std::filesystem;
 using lc::testing::dataPath;
 using lc::testing::TempDir;
+using lc::testing::binary;
+using lc::testing::slurp;
 
 namespace lc::app {
 namespace {
-
-std::string binary() {
-  if (const char* b = std::getenv("LC_BINARY")) return b;
-  // Run by hand: the binary sits beside the test executable in the build directory.
-  return (fs::read_symlink("/proc/self/exe").parent_path() / "lightcuts").string();
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
 
 // Runs `lightcuts args...` in `dir`; returns the exit status, stderr in `err`.
 int runCli(const std::vector<std::string>& args, const std::string& dir, std::string* err = nullptr) {

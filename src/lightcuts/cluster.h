@@ -21,7 +21,6 @@ struct Cluster {
   Color intensity;
   uint32_t rep = 0;
   int32_t left = -1, right = -1;
-  uint32_t count = 1;
 };
 
 // Position a light occupies in its tree: directional lights cluster by the direction
@@ -66,7 +65,6 @@ inline Cluster mergeClusters(const Cluster& a, const Cluster& b, int32_t ia, int
   c.rep = (c.weight > 0 ? u * c.weight < a.weight : u < 0.5) ? a.rep : b.rep;
   c.left = ia;
   c.right = ib;
-  c.count = a.count + b.count;
   return c;
 }
 
@@ -74,7 +72,6 @@ inline Cluster mergeClusters(const Cluster& a, const Cluster& b, int32_t ia, int
 inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, LightTree& tree) {
   tree.nodes.clear();
   tree.nodes.reserve(clusters.size());
-  tree.counts.assign(clusters.size(), 0);
   tree.nodes.push_back(LightNode{});
   std::vector<std::pair<int32_t, uint32_t>> stack{{root, 0u}};
   while (!stack.empty()) {
@@ -89,8 +86,6 @@ inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, Light
     n.intensity = c.intensity;
     n.rep = c.rep;
     n.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - c.cosHalfAngle * c.cosHalfAngle));
-    if (ni >= tree.counts.size()) tree.counts.resize(ni + 1, 0);
-    tree.counts[ni] = c.count;
     n.left = 0;
     if (c.left >= 0) {
       uint32_t j = uint32_t(tree.nodes.size());
@@ -101,7 +96,6 @@ inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, Light
       stack.emplace_back(c.left, j);
     }
   }
-  tree.counts.resize(tree.nodes.size());
 }
 
 }  // namespace lc::lightcuts::detail

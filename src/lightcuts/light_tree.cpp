@@ -14,8 +14,7 @@ namespace lc::lightcuts {
 size_t LightForest::memoryBytes() const {
   size_t b = 0;
   for (const LightTree& t : trees)
-    b += t.nodes.size() * sizeof(LightNode) + t.seed.size() * sizeof(SeedNodeData) +
-         t.counts.size() * sizeof(uint32_t);
+    b += t.nodes.size() * sizeof(LightNode) + t.seed.size() * sizeof(SeedNodeData);
   return b;
 }
 

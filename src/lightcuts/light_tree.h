@@ -47,7 +47,6 @@ struct LightTree {
   uint16_t group = 0;
   std::vector<LightNode> nodes;  // nodes[0] is the root
   std::vector<SeedNodeData> seed;  // parallel to nodes
-  std::vector<uint32_t> counts;    // parallel to nodes: lights in each cluster
 };
 
 enum class TreeBuilder { Agglomerative, Seed };

@@ -10,6 +10,12 @@
 namespace lc::lightcuts {
 namespace {
 
+// Lights under node i.
+uint32_t leafCount(const LightTree& t, uint32_t i) {
+  const LightNode& n = t.nodes[i];
+  return n.isLeaf() ? 1u : leafCount(t, n.left) + leafCount(t, n.left + 1);
+}
+
 LightSet randomLights(size_t n, LightType type, uint64_t seed, bool coloured = false) {
   LightSet s;
   s.groups.push_back(LightGroup{});
@@ -25,7 +31,7 @@ LightSet randomLights(size_t n, LightType type, uint64_t seed, bool coloured = f
   return s;
 }
 
-// Every node's box, cone, intensity and count must cover its children, and every light
+// Every node's box, cone and intensity must cover its children, and every light
 // must sit in exactly one leaf.
 void checkTree(const LightSet& set, const LightTree& t) {
   std::set<uint32_t> leaves;
@@ -34,7 +40,6 @@ void checkTree(const LightSet& set, const LightTree& t) {
     EXPECT_NEAR(n.sinHalfAngle, std::sqrt(std::max(0.0f, 1 - n.cosHalfAngle * n.cosHalfAngle)), 1e-6f);
     if (n.isLeaf()) {
       EXPECT_TRUE(leaves.insert(n.rep).second) << "light in two leaves";
-      EXPECT_EQ(t.counts[i], 1u);
       const Light& l = set.lights[n.rep];
       Vec3 p = l.type == LightType::Directional ? -l.direction : l.position;
       EXPECT_EQ(n.lo, p);
@@ -43,7 +48,6 @@ void checkTree(const LightSet& set, const LightTree& t) {
     const LightNode& a = t.nodes[n.left];
     const LightNode& b = t.nodes[n.left + 1];
     EXPECT_GT(n.left, i) << "children come after parents";
-    EXPECT_EQ(t.counts[i], t.counts[n.left] + t.counts[n.left + 1]);
     EXPECT_TRUE(n.rep == a.rep || n.rep == b.rep) << "representative comes from a child";
     for (int k = 0; k < 3; ++k) {
       EXPECT_LE(n.lo[k], std::min(a.lo[k], b.lo[k]));
@@ -106,7 +110,7 @@ TEST(TreeBuild, SeparatesGroupsAndTypes) {
   LightForest f = buildLightForest(set);
   ASSERT_EQ(f.trees.size(), 3u);
   size_t total = 0;
-  for (const LightTree& t : f.trees) total += t.counts[0];
+  for (const LightTree& t : f.trees) total += leafCount(t, 0);
   EXPECT_EQ(total, 100u);
 }
 
@@ -114,7 +118,7 @@ TEST(TreeBuild, SkipsLightsWithoutIntensity) {
   LightSet set = randomLights(10, LightType::Omni, 1);
   set.lights[3].intensity = Color(0);
   LightForest f = buildLightForest(set);
-  EXPECT_EQ(f.trees[0].counts[0], 9u);
+  EXPECT_EQ(leafCount(f.trees[0], 0), 9u);
 }
 
 // Agglomerative clustering must merge the two obvious groups last.
@@ -130,8 +134,8 @@ TEST(Agglomerative, MergesNearbyLightsFirst) {
     }
   LightForest f = buildLightForest(set);
   const LightTree& t = f.trees[0];
-  EXPECT_EQ(t.counts[t.nodes[0].left], 8u);
-  EXPECT_EQ(t.counts[t.nodes[0].left + 1], 8u);
+  EXPECT_EQ(leafCount(t, t.nodes[0].left), 8u);
+  EXPECT_EQ(leafCount(t, t.nodes[0].left + 1), 8u);
 }
 
 // The seed split falls at a gap in position rather than at the median.
@@ -146,7 +150,7 @@ TEST(SeedBuild, SplitsAtTheLargestGap) {
   }
   LightForest f = buildLightForest(set, TreeBuildOptions{TreeBuilder::Seed, 1});
   const LightTree& t = f.trees[0];
-  uint32_t a = t.counts[t.nodes[0].left], b = t.counts[t.nodes[0].left + 1];
+  uint32_t a = leafCount(t, t.nodes[0].left), b = leafCount(t, t.nodes[0].left + 1);
   EXPECT_EQ(std::min(a, b), 5u);
   // The seed error of a node of coincident equal lights is zero; of spread lights positive.
   EXPECT_GT(t.seed[0].error, 0.0f);
