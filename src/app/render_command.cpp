@@ -42,6 +42,7 @@ struct RenderArgs {
   std::string criterion = "total";
   std::string cutHeatmap;
   int referencePixels = 0;
+  int reconstruct = 4;
   std::string tonemap = "clamp";
   uint64_t seed = 1;
   LoadOptions load;
@@ -128,6 +129,7 @@ int runRender(RenderArgs& a) {
   ro.maxDepth = a.maxDepth;
   ro.seed = a.seed;
   ro.referencePixels = a.referencePixels;
+  ro.reconstructSpacing = method == lightcuts::Method::Lightcuts ? a.reconstruct : 0;
   ro.cancel = &gInterrupted;
   ProgressBar bar("rendering", a.quiet);
   ro.progress = [&](double f) { bar.update(f); };
@@ -174,6 +176,10 @@ int runRender(RenderArgs& a) {
     j["error_threshold"] = error;
     j["max_cut"] = a.maxCut;
     j["cut_criterion"] = a.criterion;
+    j["reconstruct_spacing"] = ro.reconstructSpacing;
+    j["reconstruction_samples"] = rr.stats.reconstructionSamples;
+    j["reconstructed_points"] = es.reconstructedPoints;
+    j["reconstruction_fallbacks"] = rr.stats.reconstructionFallbacks;
     j["max_depth"] = a.maxDepth;
     j["time_total_s"] = total;
     j["time_load_s"] = ls.loadSeconds;
@@ -244,6 +250,10 @@ int runRender(RenderArgs& a) {
                  double(forest.memoryBytes()) / (1 << 20), formatSeconds(forest.buildSeconds), error,
                  method == lightcuts::Method::Lightcuts ? " (" + a.criterion + " criterion)" : "", a.maxCut);
     fmt::print("image      {}x{}, {} spp -> {}\n", a.width, a.height, a.spp, a.out);
+    if (ro.reconstructSpacing > 1)
+      fmt::print("recon.     full lightcuts every {} pixels ({} samples); {} points rebuilt from them, {} got full cuts\n",
+                 ro.reconstructSpacing, formatCount(double(rr.stats.reconstructionSamples)),
+                 formatCount(double(es.reconstructedPoints)), formatCount(double(rr.stats.reconstructionFallbacks)));
     fmt::print("time       {} total: load {}, accel {}, lights {}, tree {}, render {}\n", formatSeconds(total),
                formatSeconds(ls.loadSeconds), formatSeconds(ls.accelSeconds), formatSeconds(ls.lightSeconds),
                formatSeconds(forest.buildSeconds), formatSeconds(rr.stats.seconds));
@@ -290,6 +300,10 @@ void addRenderCommand(CLI::App& app) {
                 "When a lightcut stops: total (every bound and their root-sum-square below error x estimate, default) "
                 "or walter (every bound below error x estimate, as published)")
       ->check(CLI::IsMember({"total", "walter"}));
+  c->add_option("--reconstruct", a->reconstruct,
+                "Reconstruction cuts (lightcuts): full cuts every N pixels in x and y, primary hits between them "
+                "borrow their visibility (Walter et al. 2005 sec. 5); default 4; 0 = a full cut at every point")
+      ->check(CLI::Range(0, 1024));
   c->add_option("--cut-heatmap", a->cutHeatmap, "Write the per-pixel cut size, colour-mapped with a legend, to this PNG");
   c->add_option("--reference-pixels", a->referencePixels,
                 "Also run brute force at K pixels: report the measured error and the estimated brute-force time")

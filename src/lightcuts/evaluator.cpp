@@ -54,6 +54,22 @@ inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoin
   return mg * vis(wi, dist);
 }
 
+// The same, also saying what the shadow ray found (for reconstruction cuts).
+inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoint& sp, Visibility& vis,
+                          EvalStats& stats, CutVisibility& found) {
+  Color mg;
+  Vec3 wi;
+  float dist;
+  found = CutVisibility::Untested;
+  if (!lightContribution(l, g, sp, mg, wi, dist)) return Color(0);
+  ++stats.shadowRays;
+  Color v = vis(wi, dist);
+  found = isBlack(v) ? CutVisibility::Occluded
+          : (v.x == 1 && v.y == 1 && v.z == 1) ? CutVisibility::Visible
+                                                : CutVisibility::Partial;
+  return mg * v;
+}
+
 class BruteForce final : public LightEvaluator {
  public:
   explicit BruteForce(const LightSet& lights) : lights_(lights) {}
@@ -84,6 +100,7 @@ class Lightcuts final : public LightEvaluator {
     Color unit;      // representative's M*G*V per unit intensity
     Color estimate;  // unit * cluster intensity
     float spread;    // error scale used by the total criterion (see below)
+    CutVisibility found;  // what the representative's shadow ray found
   };
 
   static uint64_t heapKey(float bound, uint32_t index) {
@@ -142,6 +159,26 @@ class Lightcuts final : public LightEvaluator {
   }
 
   EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const override {
+    return cut(sp, vis, stats, nullptr);
+  }
+  bool supportsReconstruction() const override { return true; }
+  EvalResult evaluateRecorded(const ShadingPoint& sp, Visibility& vis, EvalStats& stats,
+                              CutRecord& record) const override {
+    return cut(sp, vis, stats, &record);
+  }
+  void mergeSamples(const CutRecord* const* samples, int count, MergedCut& out) const override {
+    mergeCuts(forest_, samples, count, out);
+  }
+  EvalResult reconstruct(const ShadingPoint& sp, Visibility& vis, EvalStats& stats,
+                         const MergedCut& merged) const override {
+    ReconstructionResult r = evaluateMergedCut(lights_, merged, sp, vis, stats);
+    return {r.radiance, r.cutSize};
+  }
+
+  // The lightcut at sp; with `record`, its nodes are also written there.
+  EvalResult cut(const ShadingPoint& sp, Visibility& vis, EvalStats& stats, CutRecord* record) const {
+    static thread_local std::vector<uint64_t> recorded;  // tree << 32 | CutRecord entry
+    recorded.clear();
     static thread_local std::vector<uint64_t> heap;
     static thread_local std::vector<CutNode> nodes;
     heap.clear();
@@ -153,13 +190,19 @@ class Lightcuts final : public LightEvaluator {
     const bool rss = opt_.criterion == CutCriterion::Total;
 
     // Adds a node to the cut: its estimate to the total, and to the heap unless exact.
-    auto addNode = [&](uint32_t t, uint32_t ni, const Color& unit) {
+    auto record1 = [&](uint32_t t, uint32_t ni, CutVisibility found) {
+      recorded.push_back(uint64_t(t) << 32 | CutRecord::pack(forest_.trees[t].preorder[ni], found));
+    };
+    auto addNode = [&](uint32_t t, uint32_t ni, const Color& unit, CutVisibility found) {
       const LightTree& tree = forest_.trees[t];
       const LightNode& n = tree.nodes[ni];
       Color est = unit * n.intensity;
       total += est;
       ++cutSize;
-      if (n.isLeaf()) return;
+      if (n.isLeaf()) {
+        if (record) record1(t, ni, found);
+        return;
+      }
       ++stats.boundsEvaluated;
       const LightGroup& g = lights_.groups[tree.group];
       // The total criterion adds up how far each estimate may be off: a cluster whose
@@ -176,7 +219,9 @@ class Lightcuts final : public LightEvaluator {
         float spread = visible ? std::max(0.0f, b - luminance(lower)) : b;
         sumSq += double(spread) * spread;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
-        nodes.push_back(CutNode{t, ni, unit, est, spread});
+        nodes.push_back(CutNode{t, ni, unit, est, spread, found});
+      } else if (record) {
+        record1(t, ni, found);
       }
     };
 
@@ -184,7 +229,9 @@ class Lightcuts final : public LightEvaluator {
       const LightTree& tree = forest_.trees[t];
       if (tree.nodes.empty()) continue;
       const LightNode& root = tree.nodes[0];
-      addNode(t, 0, shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats));
+      CutVisibility found;
+      Color unit = shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats, found);
+      addNode(t, 0, unit, found);
     }
     const float eps = opt_.errorRatio;
     const double rssFactor2 = kTotalFactor * kTotalFactor;
@@ -204,9 +251,29 @@ class Lightcuts final : public LightEvaluator {
       for (uint32_t c = n.left; c <= n.left + 1; ++c) {
         uint32_t rep = tree.nodes[c].rep;
         // The child that shares the parent's representative reuses its shadow ray.
-        Color unit = rep == n.rep ? cn.unit : shadowedUnit(lights_.lights[rep], g, sp, vis, stats);
-        addNode(cn.tree, c, unit);
+        CutVisibility found = cn.found;
+        Color unit = rep == n.rep ? cn.unit : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, found);
+        addNode(cn.tree, c, unit, found);
       }
+    }
+    if (record) {
+      // The cut: the nodes left in the heap, and the exact ones recorded as they came.
+      for (uint64_t key : heap) {
+        const CutNode& cn = nodes[uint32_t(key)];
+        record1(cn.tree, cn.node, cn.found);
+      }
+      std::sort(recorded.begin(), recorded.end());
+      record->clear();
+      record->valid = true;
+      record->entries.resize(recorded.size());
+      record->treeBegin.assign(forest_.trees.size() + 1, uint32_t(recorded.size()));
+      for (size_t i = recorded.size(); i-- > 0;) {
+        record->entries[i] = uint32_t(recorded[i]);
+        record->treeBegin[recorded[i] >> 32] = uint32_t(i);
+      }
+      // Trees with no entries begin where the next one does.
+      for (size_t t = forest_.trees.size(); t-- > 0;)
+        record->treeBegin[t] = std::min(record->treeBegin[t], record->treeBegin[t + 1]);
     }
     stats.recordCut(cutSize);
     return {vmax(total, Color(0)), cutSize};

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "lightcuts/light_tree.h"
+#include "lightcuts/reconstruction.h"
 #include "lightcuts/shading.h"
 #include "scene/light.h"
 
@@ -50,6 +51,7 @@ struct EvalStats {
   uint64_t cutNodes = 0;         // nodes (lights or clusters) in the cuts
   uint64_t shadowRays = 0;
   uint64_t boundsEvaluated = 0;
+  uint64_t reconstructedPoints = 0;  // shading points given a reconstruction cut
   std::array<uint64_t, kHistogramBuckets> cutHistogram{};
 
   void recordCut(uint32_t size) {
@@ -64,6 +66,7 @@ struct EvalStats {
     cutNodes += o.cutNodes;
     shadowRays += o.shadowRays;
     boundsEvaluated += o.boundsEvaluated;
+    reconstructedPoints += o.reconstructedPoints;
     for (size_t i = 0; i < cutHistogram.size(); ++i) cutHistogram[i] += o.cutHistogram[i];
   }
 };
@@ -78,6 +81,28 @@ class LightEvaluator {
   virtual ~LightEvaluator() = default;
   virtual EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const = 0;
   virtual Method method() const = 0;
+
+  // Reconstruction cuts (reconstruction.h); only lightcuts supports them, the others
+  // evaluate every point in full.
+  virtual bool supportsReconstruction() const { return false; }
+  // evaluate(), also recording the cut as a sample for reconstruction.
+  virtual EvalResult evaluateRecorded(const ShadingPoint& sp, Visibility& vis, EvalStats& stats,
+                                      CutRecord& record) const {
+    record.clear();
+    return evaluate(sp, vis, stats);
+  }
+  // The cut that points near 1..4 samples rebuild from their recorded cuts.
+  virtual void mergeSamples(const CutRecord* const* samples, int count, MergedCut& out) const {
+    (void)samples;
+    (void)count;
+    out.clear();
+  }
+  // The direct light at sp over a merged cut.
+  virtual EvalResult reconstruct(const ShadingPoint& sp, Visibility& vis, EvalStats& stats,
+                                 const MergedCut& merged) const {
+    (void)merged;
+    return evaluate(sp, vis, stats);
+  }
 };
 
 // `lights` (and `forest`) must outlive the evaluator.

@@ -14,7 +14,8 @@ namespace lc::lightcuts {
 size_t LightForest::memoryBytes() const {
   size_t b = 0;
   for (const LightTree& t : trees)
-    b += t.nodes.size() * sizeof(LightNode) + t.seed.size() * sizeof(SeedNodeData);
+    b += t.nodes.size() * sizeof(LightNode) + t.seed.size() * sizeof(SeedNodeData) +
+         t.preorder.size() * sizeof(uint32_t);
   return b;
 }
 
@@ -128,6 +129,22 @@ void computeSeedData(const LightSet& lights, LightTree& tree) {
   }
 }
 
+void computePreorder(LightTree& tree) {
+  tree.preorder.assign(tree.nodes.size(), 0);
+  if (tree.nodes.empty()) return;
+  std::vector<uint32_t> stack{0};
+  uint32_t next = 0;
+  while (!stack.empty()) {
+    uint32_t i = stack.back();
+    stack.pop_back();
+    tree.preorder[i] = next++;
+    const LightNode& n = tree.nodes[i];
+    if (n.isLeaf()) continue;
+    stack.push_back(n.left + 1);
+    stack.push_back(n.left);
+  }
+}
+
 LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& options) {
   auto t0 = std::chrono::steady_clock::now();
   std::map<GroupKey, std::vector<uint32_t>> groups;
@@ -162,6 +179,7 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
       t = buildAgglomerativeTree(lights, idx, k.type, c, seed, std::max<size_t>(options.exactLimit, 2));
       computeSeedData(lights, t);
     }
+    computePreorder(t);
     t.type = k.type;
     t.group = k.group;
     forest.trees[i] = std::move(t);

@@ -47,6 +47,10 @@ struct LightTree {
   uint16_t group = 0;
   std::vector<LightNode> nodes;  // nodes[0] is the root
   std::vector<SeedNodeData> seed;  // parallel to nodes
+  // Parallel to nodes: each node's position in a depth-first walk that visits the left
+  // child (n.left) before the right one, so a subtree is a contiguous range. Reconstruction
+  // cuts (reconstruction.h) compare cuts of different points by it.
+  std::vector<uint32_t> preorder;
 };
 
 enum class TreeBuilder { Agglomerative, Seed };
@@ -94,6 +98,9 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
                                  size_t exactLimit = 8192);
 LightTree buildSeedTree(const LightSet& lights, const std::vector<uint32_t>& indices, LightType type,
                         uint64_t seed);
+
+// Fills LightTree::preorder (buildLightForest calls it).
+void computePreorder(LightTree& tree);
 
 // Fills LightTree::seed from the finished nodes (centroids, mean directions, errors).
 void computeSeedData(const LightSet& lights, LightTree& tree);

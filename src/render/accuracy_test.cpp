@@ -56,11 +56,53 @@ TEST(Accuracy, LightcutsWithinTwoPercentOfBruteForceOnTheCornellBox) {
   EXPECT_GT(io::compareImages(ref.image, w.image).mean_relative_error, m.mean_relative_error);
 }
 
+TEST(Accuracy, ReconstructionCutsWithinTwoPercentWithFarFewerShadowRays) {
+  Loaded l = loadCornell();
+  const scene::Scene& s = *l.scene;
+  const int W = 64;
+  auto brute = lightcuts::makeBruteForce(s.lights());
+  lightcuts::LightForest forest = lightcuts::buildLightForest(s.lights());
+  auto lc = lightcuts::makeLightcuts(s.lights(), forest, lightcuts::CutOptions{});
+  RenderResult ref = renderWith(s, *brute, W);
+  RenderResult full = renderWith(s, *lc, W);
+  RenderOptions o;
+  o.width = o.height = W;
+  o.reconstructSpacing = 4;
+  RenderResult rec = render(s, *lc, o);
+  io::ImageMetrics m = io::compareImages(ref.image, rec.image);
+  EXPECT_LE(m.fraction_over_2pct, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
+  EXPECT_GT(rec.stats.reconstructionSamples, 0u);
+  EXPECT_GT(rec.stats.eval.reconstructedPoints, rec.stats.eval.shadingPoints / 2);
+  // Most points borrow visibility: fewer shadow rays than a lightcut at every point (in
+  // an image this small, edges, where points need their own cuts, are a large share).
+  EXPECT_LT(double(rec.stats.eval.shadowRays), 0.7 * double(full.stats.eval.shadowRays));
+  for (uint8_t d : rec.done) ASSERT_EQ(d, 1);
+}
+
 }  // namespace
 }  // namespace lc::render
 
 namespace lc::render {
 namespace {
+
+TEST(Determinism, ReconstructionCutsImageIsTheSameAtOneAndTwoThreads) {
+  Loaded l = loadCornell();
+  lightcuts::LightForest forest = lightcuts::buildLightForest(l.scene->lights());
+  auto lc = lightcuts::makeLightcuts(l.scene->lights(), forest, lightcuts::CutOptions{});
+  for (int spp : {1, 2}) {
+    RenderOptions o;
+    o.width = 70;  // not a multiple of the spacing or the tile: partial cells and tiles
+    o.height = 45;
+    o.spp = spp;
+    o.reconstructSpacing = 4;
+    o.threads = 1;
+    RenderResult a = render(*l.scene, *lc, o);
+    o.threads = 2;
+    RenderResult b = render(*l.scene, *lc, o);
+    for (size_t i = 0; i < a.image.pixels.size(); ++i) ASSERT_EQ(a.image.pixels[i], b.image.pixels[i]) << spp << " " << i;
+    for (uint8_t d : a.done) ASSERT_EQ(d, 1);
+  }
+}
 
 TEST(Determinism, LightcutsImageIsTheSameAtOneAndTwoThreads) {
   Loaded l = loadCornell();

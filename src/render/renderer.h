@@ -26,6 +26,10 @@ struct RenderOptions {
   // Also evaluate K pixels (spread over the image) with brute force, to report the
   // measured error and the brute-force time the full image would take.
   int referencePixels = 0;
+  // Reconstruction cuts (lightcuts only; lightcuts/reconstruction.h): a full lightcut at
+  // every Nth pixel in x and y, the primary hits in between rebuilt from the four around
+  // them when they lie on the same surface. 0 or 1 = a full lightcut everywhere.
+  int reconstructSpacing = 0;
   // Set from a signal handler to stop early; the result is marked interrupted.
   std::atomic<bool>* cancel = nullptr;
   // Called from one thread with the fraction done (0..1), about ten times a second.
@@ -47,6 +51,8 @@ struct ReferenceStats {
 struct RenderStats {
   double seconds = 0;
   uint64_t primaryRays = 0;
+  uint64_t reconstructionSamples = 0;  // full lightcuts recorded as samples
+  uint64_t reconstructionFallbacks = 0;  // primary hits whose samples did not match: full cuts
   uint64_t secondaryRays = 0;  // reflection and refraction
   lightcuts::EvalStats eval;
   ReferenceStats reference;

@@ -1,0 +1,84 @@
+// Reconstruction cuts (Walter et al. 2005, sec. 5): share the work of lightcuts between
+// nearby shading points. A sparse set of "samples" (in the renderer: every Nth pixel in x
+// and y) get a full lightcut, recorded as a CutRecord: the cut's nodes with what the shadow
+// ray of each node's representative found. A point between samples then walks the light
+// tree top down and, at each node, looks at what its samples did there:
+//   - some sample refined the node (its cut lies below): descend to the children;
+//   - every sample kept the node (or an ancestor) and found it occluded: it contributes 0;
+//   - every sample kept it and found it visible (or had nothing to test): the node's
+//     estimate at this point, without a shadow ray;
+//   - the samples disagree, or the path went through glass: the estimate with one shadow
+//     ray, as lightcuts would.
+// So the point's cut is at least as fine as each of its samples' cuts, its material and
+// geometric terms are its own (textures, normals, highlights stay sharp), and only
+// visibility is borrowed, where all its samples agree. Shadow rays drop from the cut size
+// to those of nodes near shadow boundaries. The caller decides which samples are similar
+// enough to use (the renderer: the same surface, normals within ~25 degrees); a feature
+// thinner than the sample spacing that all samples miss is the method's blind spot.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "lightcuts/light_tree.h"
+#include "lightcuts/shading.h"
+#include "scene/light.h"
+
+namespace lc::lightcuts {
+
+struct EvalStats;
+
+// What a sample's shadow ray toward a cut node's representative found.
+enum class CutVisibility : uint8_t {
+  Visible = 0,   // unoccluded (visibility exactly 1)
+  Occluded = 1,  // blocked
+  Untested = 2,  // no ray: the representative contributes nothing at the sample
+  Partial = 3,   // through glass: a colour between 0 and 1
+};
+
+// A sample's cut: per tree, its nodes in preorder (LightTree::preorder) with their
+// CutVisibility, packed as preorder << 2 | visibility.
+struct CutRecord {
+  std::vector<uint32_t> entries;
+  std::vector<uint32_t> treeBegin;  // entries of tree t: [treeBegin[t], treeBegin[t + 1])
+  bool valid = false;               // false: no cut was recorded (the caller's miss)
+
+  void clear() {
+    entries.clear();
+    treeBegin.clear();
+    valid = false;
+  }
+  static uint32_t pack(uint32_t preorder, CutVisibility v) { return preorder << 2 | uint32_t(v); }
+};
+
+// The cut a point rebuilds from a set of samples; it depends on the samples only, so every
+// point that uses the same samples (a cell of pixels) shares one.
+struct MergedCut {
+  struct Node {
+    Color intensity;  // the node's summed intensity
+    uint32_t rep;     // its representative light
+    uint16_t group;
+    bool needsRay;    // the samples disagree, went through glass, or tested nothing
+  };
+  std::vector<Node> nodes;  // without the nodes every sample found occluded
+  uint32_t occluded = 0;    // how many those were (they are in the cut, contributing 0)
+  void clear() {
+    nodes.clear();
+    occluded = 0;
+  }
+};
+
+// Walks the trees over the cuts of `count` (1..4) samples, as described above.
+void mergeCuts(const LightForest& forest, const CutRecord* const* samples, int count, MergedCut& out);
+
+struct ReconstructionResult {
+  Color radiance;
+  uint32_t cutSize = 0;  // nodes in the reconstructed cut
+};
+
+// Direct light at `sp` over a merged cut. Shadow rays go through `vis`; shadow rays and
+// the cut are counted in `stats`.
+ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& cut, const ShadingPoint& sp,
+                                       Visibility& vis, EvalStats& stats);
+
+}  // namespace lc::lightcuts
