@@ -25,6 +25,8 @@
 #include <thread>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -439,6 +441,31 @@ TEST(CliRender, ValidSceneWritesTheImage) {
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir.file("out.png")));
   EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"s.ray", "out.png"}));
+}
+
+// Reconstruction cuts are on by default for lightcuts, off on request, and reported.
+TEST(CliRender, ReconstructionCutsByDefaultAndOffOnRequest) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + "camera { position = (0,0,4); }\npoint_light { position = (0,0,4); }\n"
+                                          "point_light { position = (1,1,4); }\n"
+                                          "sphere { material = { diffuse = (1,1,1); }; }");
+  auto stats = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"render", "s.ray", "-o", "out.png", "-q", "--width", "32", "--stats", "s.json"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    CliResult r = run(args, dir.path());
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(slurp(dir.file("s.json")));
+  };
+  nlohmann::json a = stats({});
+  EXPECT_EQ(a["reconstruct_spacing"].get<int>(), 4);
+  EXPECT_GT(a["reconstruction_samples"].get<int>(), 0);
+  EXPECT_GT(a["reconstructed_points"].get<int>(), 0);
+  nlohmann::json b = stats({"--reconstruct", "0"});
+  EXPECT_EQ(b["reconstruct_spacing"].get<int>(), 0);
+  EXPECT_EQ(b["reconstructed_points"].get<int>(), 0);
+  EXPECT_EQ(b["reconstruction_samples"].get<int>(), 0);
+  nlohmann::json c = stats({"--method", "brute"});
+  EXPECT_EQ(c["reconstruct_spacing"].get<int>(), 0);
 }
 
 // A scene can come from a pipe (e.g. `lightcuts render <(generator)`): it is read up to

@@ -4,6 +4,8 @@
 //   lightcuts  Walter et al. 2005: a cut through the light tree chosen per point by a
 //              max-heap on the clusters' error upper bounds, refined until every bound is
 //              below errorRatio times the current estimate (or maxCut nodes).
+//              Its cuts can be recorded at sparse samples and rebuilt between them
+//              (reconstruction cuts, reconstruction.h).
 //   seed       the course project's traversal: descend while a node's error radius over
 //              its distance exceeds errorRatio; a blocked representative is replaced by its
 //              two children (one level, not recursively).

@@ -281,21 +281,20 @@ struct ReconstructionTile {
   EvalStats& stats;
   uint64_t &primary, &secondary, &samples, &fallbacks;
   std::vector<CutSample>& slots;
-  std::vector<uint8_t>& state;  // per slot: kPending, kSampled, kDone
+  std::vector<uint8_t>& state;  // per slot: kSampled and kDone bits
   CellCuts& cell;
   RenderResult& res;
   int x0, y0, x1, y1;  // the tile's pixels: [x0, x1) x [y0, y1)
 
-  static constexpr uint8_t kPending = 0, kSampled = 1, kDone = 2;
+  static constexpr uint8_t kSampled = 1, kDone = 2;  // the slot holds a sample; its pixel is stored
 
   size_t slot(int x, int y) const { return size_t(y - y0) * size_t(x1 - x0 + 1) + size_t(x - x0); }
 
   const CutSample& sample(int x, int y) {
     size_t i = slot(x, y);
     CutSample& cs = slots[i];
-    if (state[i] == kSampled) return cs;
-    bool pending = state[i] == kPending;
-    state[i] = kSampled;
+    if (state[i] & kSampled) return cs;
+    state[i] |= kSampled;
     cs.cut.clear();
     cs.shape = -1;
     PrimaryHook hook;
@@ -304,8 +303,10 @@ struct ReconstructionTile {
     ++samples;
     // With one sample per pixel the sample is the pixel; otherwise the pixel is rendered
     // from its samples like any other.
-    if (o.spp == 1 && x < x1 && y < y1) storePixel(res, o.width, x, y, p);
-    if (o.spp > 1 && pending) state[i] = kPending;
+    if (o.spp == 1 && x < x1 && y < y1) {
+      storePixel(res, o.width, x, y, p);
+      state[i] |= kDone;
+    }
     return cs;
   }
 
@@ -317,7 +318,7 @@ struct ReconstructionTile {
     maxSeparation = kSampleMaxFootprints * float(S) * length(a - b);
     size_t n = size_t(x1 - x0 + 1) * size_t(y1 - y0 + 1);
     if (slots.size() < n) slots.resize(n);
-    state.assign(n, kPending);
+    state.assign(n, 0);
     for (int cy = y0; cy < y1; cy += S)
       for (int cx = x0; cx < x1; cx += S) cellPixels(cx, cy, std::min(S, x1 - cx), std::min(S, y1 - cy));
   }
@@ -340,9 +341,10 @@ struct ReconstructionTile {
   // The pixels [cx, cx + w) x [cy, cy + h) still pending; corners at cx + w and cy + h
   // (clipped to the image: a last cell's far corner is its own last pixel).
   void cellPixels(int cx, int cy, int w, int h) {
+    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
     bool any = false;
     for (int y = cy; y < cy + h && !any; ++y)
-      for (int x = cx; x < cx + w && !any; ++x) any = state[slot(x, y)] == kPending;
+      for (int x = cx; x < cx + w && !any; ++x) any = !(state[slot(x, y)] & kDone);
     if (!any) return;
     const int xa = cx, xb = std::min(cx + w, o.width - 1), ya = cy, yb = std::min(cy + h, o.height - 1);
     const CutSample* corners[4];
@@ -368,7 +370,7 @@ struct ReconstructionTile {
     for (int y = cy; y < cy + h; ++y)
       for (int x = cx; x < cx + w; ++x) {
         uint8_t& st = state[slot(x, y)];
-        if (st != kPending) continue;
+        if (st & kDone) continue;
         hook.px = x;
         hook.py = y;
         int shape = -1;
@@ -382,7 +384,7 @@ struct ReconstructionTile {
         hook.fallbacks = 0;
         storePixel(res, o.width, x, y, renderPixel(scene, ev, o, x, y, stats, primary, secondary, &hook));
         fallbacks += hook.fallbacks;
-        st = kDone;
+        st |= kDone;
       }
     if (!left) return;
     int w0 = w > 1 ? w / 2 : w, h0 = h > 1 ? h / 2 : h;
@@ -541,7 +543,8 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   cv.notify_all();
   if (reporter.joinable()) reporter.join();
   if (o.progress) o.progress(double(tilesDone) / double(totalTiles));
-  res.interrupted = o.cancel && o.cancel->load() && tilesDone < totalTiles;
+  // A cancelled render may stop inside a tile (reconstruction tiles check between cells).
+  res.interrupted = o.cancel && o.cancel->load() && std::find(res.done.begin(), res.done.end(), 0) != res.done.end();
 
   for (const Local& L : locals) {
     res.stats.eval.add(L.stats);

@@ -1,6 +1,7 @@
 // The Whitted-style renderer: camera rays per pixel (stratified supersampling), Phong
 // shading with direct light from a pluggable LightEvaluator (brute force, Lightcuts or the
-// seed's cuts), reflection and refraction by recursion. Tiles render in parallel with
+// seed's cuts; at primary hits optionally reconstruction cuts, RenderOptions::
+// reconstructSpacing), reflection and refraction by recursion. Tiles render in parallel with
 // oneTBB; every pixel draws from its own random stream, so the image is the same bit for
 // bit at any thread count.
 #pragma once
