@@ -54,7 +54,6 @@ struct CutSample {
   Vec3 p, n;
 };
 
-
 // A hit and a sample are on one surface when they share the shape, their normals are
 // within ~25 degrees, and the sample lies near the hit's tangent plane (within ~12
 // degrees of it seen from the hit): one mesh often holds many parallel faces, a column's
@@ -96,7 +95,7 @@ struct PrimaryHook {
   float maxSeparation = kInf;  // how far a sample may be, over the point's distance to it
   int px = 0, py = 0;         // the pixel, and
   int cx[4] = {}, cy[4] = {};  // the samples' pixels
-  uint64_t fallbacks = 0;  // hits that matched too few samples and got a full cut
+  uint64_t fallbacks = 0;  // hits no sample could serve: they got a full lightcut
 };
 
 // Whether pixel (x, y) lies in the convex hull of the samples in `mask`: a point borrows
