@@ -43,18 +43,8 @@ namespace {
 // emitters are mostly hidden; docs/LIGHTCUTS.md has the figures).
 constexpr double kTotalFactor = 1.75;
 
-// M * G * V of one light per unit intensity (one shadow ray when the rest is non-zero).
-inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoint& sp, Visibility& vis,
-                          EvalStats& stats) {
-  Color mg;
-  Vec3 wi;
-  float dist;
-  if (!lightContribution(l, g, sp, mg, wi, dist)) return Color(0);
-  ++stats.shadowRays;
-  return mg * vis(wi, dist);
-}
-
-// The same, also saying what the shadow ray found (for reconstruction cuts).
+// M * G * V of one light per unit intensity (one shadow ray when the rest is non-zero),
+// and what the shadow ray found (recorded for reconstruction cuts).
 inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoint& sp, Visibility& vis,
                           EvalStats& stats, CutVisibility& found) {
   Color mg;
@@ -75,8 +65,9 @@ class BruteForce final : public LightEvaluator {
   explicit BruteForce(const LightSet& lights) : lights_(lights) {}
   EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const override {
     Color sum(0);
+    CutVisibility found;
     for (const Light& l : lights_.lights)
-      sum += shadowedUnit(l, lights_.groups[l.group], sp, vis, stats) * l.intensity;
+      sum += shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, found) * l.intensity;
     uint32_t n = uint32_t(lights_.lights.size());
     stats.recordCut(n);
     return {sum, n};
@@ -341,7 +332,8 @@ class SeedCuts final : public LightEvaluator {
                   Visibility& vis, EvalStats& stats, bool& blocked) const {
     const LightNode& n = tree.nodes[ni];
     blocked = false;
-    if (n.isLeaf()) return shadowedUnit(lights_.lights[n.rep], g, sp, vis, stats) * n.intensity;
+    CutVisibility found;
+    if (n.isLeaf()) return shadowedUnit(lights_.lights[n.rep], g, sp, vis, stats, found) * n.intensity;
     const SeedNodeData& sd = tree.seed[ni];
     Light syn;
     syn.type = tree.type;

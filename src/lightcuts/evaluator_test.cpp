@@ -8,9 +8,13 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "lightcuts/bounds.h"
+#include "lightcuts/test_lights.h"
 
 namespace lc::lightcuts {
 namespace {
+
+using test_lights::cloud;
+using test_lights::point;
 
 struct Unoccluded : Visibility {
   Color operator()(const Vec3&, float) override { return Color(1); }
@@ -20,32 +24,6 @@ struct Unoccluded : Visibility {
 struct HalfBlocked : Visibility {
   Color operator()(const Vec3& wi, float) override { return wi.x < 0 ? Color(0) : Color(1); }
 };
-
-LightSet cloud(size_t n, LightType type, uint64_t seed) {
-  LightSet s;
-  s.groups.push_back(LightGroup{});
-  Rng r(seed, 2);
-  for (size_t i = 0; i < n; ++i) {
-    Light l;
-    l.type = type;
-    l.position = Vec3(r.uniform() * 4 - 2, 2 + r.uniform(), r.uniform() * 4 - 2);
-    l.direction = normalize(Vec3(r.uniform() - 0.5f, -1, r.uniform() - 0.5f));
-    l.intensity = Color(r.uniform(), r.uniform(), r.uniform()) * 0.01f;
-    s.lights.push_back(l);
-  }
-  return s;
-}
-
-ShadingPoint point(Vec3 p) {
-  ShadingPoint sp;
-  sp.p = p;
-  sp.n = Vec3(0, 1, 0);
-  sp.r = normalize(Vec3(0.3f, 1, 0.1f));
-  sp.kd = Color(0.7f, 0.6f, 0.5f);
-  sp.ks = Color(0.3f);
-  sp.shininess = 10;
-  return sp;
-}
 
 TEST(BruteForce, SumsEveryLight) {
   LightSet s = cloud(50, LightType::Omni, 1);

@@ -4,11 +4,14 @@
 
 #include <functional>
 
-#include "core/rng.h"
 #include "lightcuts/evaluator.h"
+#include "lightcuts/test_lights.h"
 
 namespace lc::lightcuts {
 namespace {
+
+using test_lights::cloud;
+using test_lights::point;
 
 // Visibility from a function of the direction, counting the rays it answers.
 struct CountingVisibility : Visibility {
@@ -25,36 +28,13 @@ Color open(const Vec3&) { return Color(1); }
 Color halfBlocked(const Vec3& wi) { return wi.x < 0 ? Color(0) : Color(1); }
 Color allBlocked(const Vec3&) { return Color(0); }
 
-LightSet cloud(size_t n, uint64_t seed) {
-  LightSet s;
-  s.groups.push_back(LightGroup{});
-  Rng r(seed, 3);
-  for (size_t i = 0; i < n; ++i) {
-    Light l;
-    l.type = LightType::Omni;
-    l.position = Vec3(r.uniform() * 4 - 2, 2 + r.uniform(), r.uniform() * 4 - 2);
-    l.intensity = Color(r.uniform(), r.uniform(), r.uniform()) * 0.01f;
-    s.lights.push_back(l);
-  }
-  return s;
-}
-
-ShadingPoint point(Vec3 p) {
-  ShadingPoint sp;
-  sp.p = p;
-  sp.n = Vec3(0, 1, 0);
-  sp.r = normalize(Vec3(0.3f, 1, 0.1f));
-  sp.kd = Color(0.7f, 0.6f, 0.5f);
-  return sp;
-}
-
 uint32_t subtreeSize(const LightTree& t, uint32_t i) {
   const LightNode& n = t.nodes[i];
   return n.isLeaf() ? 1 : 1 + subtreeSize(t, n.left) + subtreeSize(t, n.left + 1);
 }
 
 struct Fixture {
-  LightSet lights = cloud(3000, 11);
+  LightSet lights = cloud(3000, LightType::Omni, 11);
   LightForest forest = buildLightForest(lights);
   std::unique_ptr<LightEvaluator> lc = makeLightcuts(lights, forest, CutOptions{});
 
