@@ -1,4 +1,5 @@
 #include "lightcuts/light_tree.h"
+#include "lightcuts/test_lights.h"
 
 #include <gtest/gtest.h>
 
@@ -10,11 +11,7 @@
 namespace lc::lightcuts {
 namespace {
 
-// Lights under node i.
-uint32_t leafCount(const LightTree& t, uint32_t i) {
-  const LightNode& n = t.nodes[i];
-  return n.isLeaf() ? 1u : leafCount(t, n.left) + leafCount(t, n.left + 1);
-}
+using test_lights::leafCount;
 
 LightSet randomLights(size_t n, LightType type, uint64_t seed, bool coloured = false) {
   LightSet s;

@@ -82,10 +82,7 @@ TEST(Reconstruction, RecordedCutIsThePartitionTheLightcutUsed) {
     uint32_t node = byPre[e >> 2];
     EXPECT_GE(e >> 2, next) << "overlapping subtrees";
     next = (e >> 2) + subtreeSize(t, node);
-    auto countLeaves = [&](auto&& self, uint32_t i) -> uint32_t {
-      return t.nodes[i].isLeaf() ? 1 : self(self, t.nodes[i].left) + self(self, t.nodes[i].left + 1);
-    };
-    leaves += countLeaves(countLeaves, node);
+    leaves += test_lights::leafCount(t, node);
     EXPECT_EQ(CutVisibility(e & 3), CutVisibility::Visible);
   }
   EXPECT_EQ(leaves, f.lights.lights.size());

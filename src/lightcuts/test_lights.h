@@ -1,7 +1,8 @@
-// Light sets and shading points shared by the lightcuts tests.
+// Light sets, shading points and tree helpers shared by the lightcuts tests.
 #pragma once
 
 #include "core/rng.h"
+#include "lightcuts/light_tree.h"
 #include "lightcuts/shading.h"
 #include "scene/light.h"
 
@@ -33,6 +34,12 @@ inline ShadingPoint point(Vec3 p) {
   sp.ks = Color(0.3f);
   sp.shininess = 10;
   return sp;
+}
+
+// Lights under node i.
+inline uint32_t leafCount(const LightTree& t, uint32_t i) {
+  const LightNode& n = t.nodes[i];
+  return n.isLeaf() ? 1u : leafCount(t, n.left) + leafCount(t, n.left + 1);
 }
 
 }  // namespace lc::lightcuts::test_lights

@@ -27,9 +27,10 @@ Loaded loadCornell() {
   return l;
 }
 
-RenderResult renderWith(const scene::Scene& s, const lightcuts::LightEvaluator& ev, int w) {
+RenderResult renderWith(const scene::Scene& s, const lightcuts::LightEvaluator& ev, int w, int reconstruct = 0) {
   RenderOptions o;
   o.width = o.height = w;
+  o.reconstructSpacing = reconstruct;
   return render(s, ev, o);
 }
 
@@ -65,10 +66,7 @@ TEST(Accuracy, ReconstructionCutsWithinTwoPercentWithFarFewerShadowRays) {
   auto lc = lightcuts::makeLightcuts(s.lights(), forest, lightcuts::CutOptions{});
   RenderResult ref = renderWith(s, *brute, W);
   RenderResult full = renderWith(s, *lc, W);
-  RenderOptions o;
-  o.width = o.height = W;
-  o.reconstructSpacing = 4;
-  RenderResult rec = render(s, *lc, o);
+  RenderResult rec = renderWith(s, *lc, W, 4);
   io::ImageMetrics m = io::compareImages(ref.image, rec.image);
   EXPECT_LE(m.fraction_over_2pct, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
   EXPECT_GT(rec.stats.reconstructionSamples, 0u);

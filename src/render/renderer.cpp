@@ -516,15 +516,10 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
         if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
         int x0 = tx * kTile, y0 = ty * kTile;
         int x1 = std::min(o.width, (tx + 1) * kTile), y1 = std::min(o.height, (ty + 1) * kTile);
-        auto store = [&](int x, int y, const PixelResult& p) {
-          size_t i = size_t(y) * size_t(o.width) + size_t(x);
-          res.image.pixels[i] = p.color;
-          res.cutSize[i] = p.cut;
-          res.done[i] = 1;
-        };
         if (!recon) {
           for (int y = y0; y < y1; ++y)
-            for (int x = x0; x < x1; ++x) store(x, y, renderPixel(scene, evaluator, o, x, y, L.stats, L.primary, L.secondary));
+            for (int x = x0; x < x1; ++x)
+              storePixel(res, o.width, x, y, renderPixel(scene, evaluator, o, x, y, L.stats, L.primary, L.secondary));
           ++tilesDone;
           continue;
         }
