@@ -252,8 +252,18 @@ void Scene::buildGeometry(const BuildOptions& options) {
   rtcSetDeviceErrorFunction(device_, embreeErrorFunc, nullptr);
   rtc_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(rtc_, RTC_BUILD_QUALITY_HIGH);
+  convex_.resize(shapes_.size());
+  transmissive_.resize(shapes_.size());
   for (size_t i = 0; i < shapes_.size(); ++i) {
     Shape& sh = shapes_[i];
+    const Mesh* mesh = sh.kind == ShapeKind::Mesh ? &meshes_[size_t(sh.mesh)] : nullptr;
+    convex_[i] = isConvexShape(sh, mesh);
+    bool glass = !materials_[size_t(sh.material)].transmissive.isBlack();
+    if (mesh) {
+      for (int m : mesh->triangleMaterials) glass |= !materials_[size_t(m)].transmissive.isBlack();
+      for (int m : mesh->vertexMaterials) glass |= !materials_[size_t(m)].transmissive.isBlack();
+    }
+    transmissive_[i] = glass;
     RTCGeometry g;
     if (sh.kind == ShapeKind::Mesh) {
       const Mesh& m = meshes_[size_t(sh.mesh)];
@@ -367,6 +377,26 @@ bool Scene::occluded(const Vec3& origin, const Vec3& dir, float tmax) const {
   r.flags = 0;
   rtcOccluded1(rtc_, &ctx, &r);
   return r.tfar < 0;
+}
+
+int Scene::firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t) const {
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  RTCRayHit rh;
+  rh.ray.org_x = origin.x; rh.ray.org_y = origin.y; rh.ray.org_z = origin.z;
+  rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
+  rh.ray.tnear = 0;
+  rh.ray.tfar = tmax;
+  rh.ray.time = 0;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(rtc_, &ctx, &rh);
+  if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
+  t = rh.ray.tfar;
+  return int(rh.hit.geomID);
 }
 
 Color Scene::transmittance(const Vec3& origin, const Vec3& dir, float tmax) const {

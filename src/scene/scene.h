@@ -62,7 +62,14 @@ class Scene {
   Color transmittance(const Vec3& origin, const Vec3& dir, float tmax) const;
   // Binary visibility, the fast path for scenes without transmissive materials.
   bool occluded(const Vec3& origin, const Vec3& dir, float tmax) const;
+  // The nearest surface along the segment: its shape index and distance, or -1.
+  int firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t) const;
   bool hasTransmissive() const { return hasTransmissive_; }
+  // Whether a shape is a convex solid or a flat convex polygon: one that blocks a set of
+  // directions from a point blocks their convex hull too.
+  bool isConvex(int shape) const { return convex_[size_t(shape)] != 0; }
+  // Whether light can pass through some part of a shape (a transmissive material).
+  bool isTransmissive(int shape) const { return transmissive_[size_t(shape)] != 0; }
 
   // Material values at a hit (textures looked up, per-vertex materials blended).
   ShadingMaterial shadingMaterial(const Hit& hit) const;
@@ -98,6 +105,8 @@ class Scene {
   Bounds3 bounds_;
   float epsilon_ = 1e-4f;
   bool hasTransmissive_ = false;
+  std::vector<uint8_t> convex_;        // per shape
+  std::vector<uint8_t> transmissive_;  // per shape
   RTCDevice device_ = nullptr;
   RTCScene rtc_ = nullptr;
 };

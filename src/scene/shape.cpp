@@ -1,6 +1,9 @@
 #include "scene/shape.h"
 
+#include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
 
 namespace lc::scene {
 
@@ -235,6 +238,115 @@ Bounds3 quadricBounds(const Shape& s) {
   world.lo -= pad;
   world.hi += pad;
   return world;
+}
+
+bool isConvexShape(const Shape& s, const Mesh* mesh) {
+  switch (s.kind) {
+    case io::ShapeKind::Sphere:
+    case io::ShapeKind::Box:
+    case io::ShapeKind::Square: return true;
+    case io::ShapeKind::Cylinder:
+    case io::ShapeKind::Cone: return s.capped;
+    case io::ShapeKind::Mesh: break;
+  }
+  if (!mesh || mesh->triangles.empty() || mesh->triangles.size() > 4096 || mesh->positions.size() > 4096) return false;
+  const std::vector<Vec3>& v = mesh->positions;
+  Bounds3 b;
+  for (const auto& t : mesh->triangles)
+    for (int k : t) b.extend(v[size_t(k)]);
+  const float tol = 1e-4f * b.diagonal();
+  if (!(tol > 0)) return false;
+  // Every face's plane must have every vertex on one side: the faces lie on the boundary
+  // of the vertices' convex hull.
+  double area = 0;
+  Vec3 n0(0.0f);
+  bool planar = true;
+  for (const auto& t : mesh->triangles) {
+    const Vec3 &a = v[size_t(t[0])], &b1 = v[size_t(t[1])], &c = v[size_t(t[2])];
+    Vec3 n = cross(b1 - a, c - a);
+    float len = length(n);
+    if (!(len > 0)) continue;
+    area += 0.5 * len;
+    n = n / len;
+    if (length2(n0) == 0) n0 = n;
+    bool below = false, above = false;
+    for (const auto& u : mesh->triangles)
+      for (int k : u) {
+        float d = dot(v[size_t(k)] - a, n);
+        below |= d < -tol;
+        above |= d > tol;
+        planar &= std::fabs(dot(v[size_t(k)] - a, n0)) <= tol;
+      }
+    if (below && above) return false;
+  }
+  if (length2(n0) == 0) return false;
+  if (planar) {
+    // A flat mesh is convex when its triangles cover exactly the hull of its vertices.
+    Vec3 e1, e2;
+    orthonormalBasis(n0, e1, e2);
+    std::vector<std::pair<double, double>> pts;
+    for (const auto& t : mesh->triangles)
+      for (int k : t) pts.emplace_back(dot(v[size_t(k)], e1), dot(v[size_t(k)], e2));
+    std::sort(pts.begin(), pts.end());
+    pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+    if (pts.size() < 3) return false;
+    auto cr = [](const std::pair<double, double>& o, const std::pair<double, double>& p,
+                 const std::pair<double, double>& q) {
+      return (p.first - o.first) * (q.second - o.second) - (p.second - o.second) * (q.first - o.first);
+    };
+    std::vector<std::pair<double, double>> h(2 * pts.size());
+    size_t k = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {  // Andrew's monotone chain
+      while (k >= 2 && cr(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+      h[k++] = pts[i];
+    }
+    for (size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {
+      while (k >= t && cr(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+      h[k++] = pts[i];
+    }
+    double hull = 0;
+    for (size_t i = 0; i + 1 < k; ++i) hull += h[i].first * h[i + 1].second - h[i + 1].first * h[i].second;
+    hull = 0.5 * std::fabs(hull);
+    return hull > 0 && std::fabs(area - hull) <= 1e-3 * hull;
+  }
+  // A solid: closed, or open along one planar loop (a box without its bottom): a line
+  // through the hull cannot enter and leave through one planar opening, so it meets a face.
+  // Vertices are welded by position first: meshes often repeat a corner per face.
+  std::vector<int> weld(v.size());
+  for (size_t i = 0; i < v.size(); ++i) {
+    weld[i] = int(i);
+    for (size_t j = 0; j < i; ++j)
+      if (length(v[i] - v[j]) <= tol) {
+        weld[i] = weld[j];
+        break;
+      }
+  }
+  std::map<std::pair<int, int>, int> edges;
+  for (const auto& t : mesh->triangles)
+    for (int j = 0; j < 3; ++j) {
+      int a = weld[size_t(t[size_t(j)])], c = weld[size_t(t[size_t((j + 1) % 3)])];
+      if (a != c) ++edges[{std::min(a, c), std::max(a, c)}];
+    }
+  std::vector<Vec3> open;
+  for (const auto& [e, count] : edges) {
+    if (count > 2) return false;
+    if (count == 1) {
+      open.push_back(v[size_t(e.first)]);
+      open.push_back(v[size_t(e.second)]);
+    }
+  }
+  if (open.empty()) return true;
+  if (open.size() < 6) return false;
+  // The opening's points must lie in one plane.
+  Vec3 on(0.0f);
+  for (size_t i = 2; i < open.size() && length2(on) == 0; ++i) {
+    Vec3 c = cross(open[1] - open[0], open[i] - open[0]);
+    if (length(c) > tol * tol) on = normalize(c);
+  }
+  if (length2(on) == 0) return false;
+  for (const Vec3& q : open)
+    if (std::fabs(dot(q - open[0], on)) > tol) return false;
+  return true;
 }
 
 }  // namespace lc::scene

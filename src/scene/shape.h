@@ -56,4 +56,10 @@ Vec2 quadricUv(const Shape& s, const Vec3& p, int part);
 // World bounds of a quadric (its local bounding box, transformed).
 Bounds3 quadricBounds(const Shape& s);
 
+// Whether the shape is a convex solid (sphere, box, capped cylinder or cone, a closed
+// mesh with every vertex behind every face's plane) or a flat convex polygon (square, a
+// planar mesh whose triangles cover exactly the convex hull of its vertices). Any affine
+// transform keeps convexity. Meshes over 4096 triangles are not tested (false).
+bool isConvexShape(const Shape& s, const Mesh* mesh);
+
 }  // namespace lc::scene
