@@ -443,24 +443,27 @@ TEST(CliRender, ValidSceneWritesTheImage) {
   EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"s.ray", "out.png"}));
 }
 
-// Reconstruction cuts are on by default for lightcuts, off on request, and reported.
+// Reconstruction cuts are on by default for lightcuts from 512 x 512 pixels, off below or
+// on request, and reported.
 TEST(CliRender, ReconstructionCutsByDefaultAndOffOnRequest) {
   TempDir dir;
   writeText(dir.file("s.ray"), kHeader + "camera { position = (0,0,4); }\npoint_light { position = (0,0,4); }\n"
                                           "point_light { position = (1,1,4); }\n"
                                           "sphere { material = { diffuse = (1,1,1); }; }");
-  auto stats = [&](std::vector<std::string> extra) {
-    std::vector<std::string> args = {"render", "s.ray", "-o", "out.png", "-q", "--width", "32", "--stats", "s.json"};
+  auto stats = [&](std::vector<std::string> extra, const char* width = "32") {
+    std::vector<std::string> args = {"render", "s.ray", "-o", "out.png", "-q", "--width", width, "--stats", "s.json"};
     args.insert(args.end(), extra.begin(), extra.end());
     CliResult r = run(args, dir.path());
     EXPECT_EQ(r.status, 0) << r.err;
     return nlohmann::json::parse(slurp(dir.file("s.json")));
   };
-  nlohmann::json a = stats({});
+  nlohmann::json a = stats({}, "512");
   EXPECT_EQ(a["reconstruct_spacing"].get<int>(), 4);
   EXPECT_GT(a["reconstruction_samples"].get<int>(), 0);
   EXPECT_GT(a["reconstructed_points"].get<int>(), 0);
-  nlohmann::json b = stats({"--reconstruct", "0"});
+  EXPECT_EQ(stats({})["reconstruct_spacing"].get<int>(), 0);  // under 512 x 512: full cuts
+  EXPECT_EQ(stats({"--reconstruct", "4"})["reconstruct_spacing"].get<int>(), 4);
+  nlohmann::json b = stats({"--reconstruct", "0"}, "512");
   EXPECT_EQ(b["reconstruct_spacing"].get<int>(), 0);
   EXPECT_EQ(b["reconstructed_points"].get<int>(), 0);
   EXPECT_EQ(b["reconstruction_samples"].get<int>(), 0);

@@ -102,12 +102,18 @@ struct RotatedBox {
 // Upper bound (RGB) of the sum of the unshadowed contributions of the node's lights and,
 // when `lower` is given, a lower bound: with visibility 1 the cluster gives something in
 // [lower, upper], so upper - lower bounds the error of an unoccluded cluster's estimate.
+// `smooth` (with `lower`) tells whether every light's contribution is a smooth function
+// of its position and normal over the cluster: omni or oriented lights, every cosine
+// bounded away from 0 (no clamp at the horizon) and no corner of the attenuation's clamp
+// between the nearest and farthest light. Only then is the first-order estimate
+// (estimate.h) valid.
 inline Color clusterBounds(const LightNode& node, LightType type, const LightGroup& g, const ShadingPoint& sp,
-                           const BoundFrames& fr, Color* lower) {
+                           const BoundFrames& fr, Color* lower, bool* smooth = nullptr) {
   // Cosine bounds get a little slack so float rounding in the exact evaluation can never
   // exceed them (steep spot falloffs and high Phong exponents amplify it).
   constexpr float kSlack = 2e-5f;
   if (lower) *lower = Color(0);
+  if (smooth) *smooth = false;
   Vec3 lo, hi;  // vectors from the shading point toward the cluster's lights
   if (type == LightType::Directional) {
     lo = node.lo;
@@ -129,15 +135,19 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
   bool specular = !g.diffuseOnly && sp.hasSpecular();
   Color mUp = sp.kd * std::min(1.0f, cN + kSlack);
   Color mLo = sp.kd * cNLo;
+  bool sm = lower && cNLo > 0 && (type == LightType::Omni || type == LightType::Oriented);
   if (specular) {
     RotatedBox br(fr.r, c, h);
     mUp += sp.ks * std::pow(std::min(1.0f, br.cosUpper() + kSlack), sp.shininess);
-    if (cNLo > 0) mLo += sp.ks * std::pow(std::max(0.0f, (br.cz - br.hz) / dMax), sp.shininess);
+    float cRLo = cNLo > 0 ? std::max(0.0f, (br.cz - br.hz) / dMax) : 0.0f;
+    if (cNLo > 0) mLo += sp.ks * std::pow(cRLo, sp.shininess);
+    sm = sm && cRLo > 0;
   }
   float gUp = 1, gLo = 1;
   if (type != LightType::Directional) {
     gUp = g.atten(dMin);
     if (lower) gLo = g.atten(dMax);
+    sm = sm && gLo > 0 && !g.atten.kinkBetween(dMin, dMax);
     if (type == LightType::Oriented || type == LightType::Spot) {
       // The light's cosine is between its axis a and the direction from a light to the
       // point, which lies in the box -[lo, hi]: projection onto a over the length, bounded
@@ -153,10 +163,12 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
         // 0 means "may be 90 degrees or more", not a cosine: no lower bound then.
         float cLo = dMax > 0 ? coneNarrow(std::max(0.0f, (pc - ph) / dMax), node.cosHalfAngle, node.sinHalfAngle) : 0.0f;
         gLo *= cLo <= 0 ? 0.0f : (type == LightType::Oriented ? cLo : g.falloff(cLo));
+        sm = sm && cLo > 0;
       }
     }
   }
   if (lower) *lower = mLo * (gLo * 0.9999f) * node.intensity;
+  if (smooth) *smooth = sm && type != LightType::Directional;
   // A little slack so float rounding never puts the bound below an exact value.
   return mUp * (gUp * 1.0001f) * node.intensity;
 }

@@ -5,116 +5,16 @@
 #include <gtest/gtest.h>
 
 #include "core/rng.h"
-#include "lightcuts/cluster.h"
+#include "lightcuts/test_lights.h"
 
 namespace lc::lightcuts {
 namespace {
 
-Vec3 randomUnit(Rng& r) {
-  for (;;) {
-    Vec3 v(2 * r.uniform() - 1, 2 * r.uniform() - 1, 2 * r.uniform() - 1);
-    float l2 = length2(v);
-    if (l2 > 1e-4f && l2 <= 1) return v / std::sqrt(l2);
-  }
-}
-
-// A direction within `angle` radians of `axis`.
-Vec3 randomInCone(Rng& r, const Vec3& axis, float angle) {
-  float cosT = 1 - r.uniform() * (1 - std::cos(angle));
-  float sinT = std::sqrt(std::max(0.0f, 1 - cosT * cosT));
-  float phi = 2 * kPi * r.uniform();
-  Vec3 u, v;
-  orthonormalBasis(axis, u, v);
-  return normalize(axis * cosT + u * (sinT * std::cos(phi)) + v * (sinT * std::sin(phi)));
-}
-
-LightGroup randomGroup(Rng& r, LightType type) {
-  LightGroup g;
-  switch (r.below(4)) {
-    case 0: g.atten = Attenuation{0, 0, 1, kInf}; break;
-    case 1: g.atten = Attenuation{r.uniform(), r.uniform(), r.uniform() * 0.5f, kInf}; break;
-    case 2: g.atten = Attenuation{0.25f, 0.003372407f, 0.000045492f, kInf}; break;
-    default: g.atten = Attenuation{1, 0, 0, 2 + 5 * r.uniform()}; break;
-  }
-  if (type == LightType::Directional) g.atten = Attenuation{0, 0, 0, kInf};
-  if (type == LightType::Spot) {
-    g.falloff.exponent = r.below(2) ? 0.0f : 10 * r.uniform();
-    g.falloff.cosCutoff = std::cos(kPi * (0.1f + 0.8f * r.uniform()));
-    if (r.below(2)) {
-      float outer = kPi * 0.4f * r.uniform();
-      float inner = outer * r.uniform();
-      g.falloff.cosOuter = std::cos(outer);
-      g.falloff.cosInner = std::max(std::cos(inner), g.falloff.cosOuter + 1e-6f);
-    }
-  }
-  g.diffuseOnly = r.below(4) == 0;
-  return g;
-}
-
-struct Config {
-  LightSet set;
-  LightNode node;
-  ShadingPoint sp;
-};
-
-// A random cluster of one type plus a random shading point, sometimes inside the
-// cluster's box, sometimes facing away.
-Config randomConfig(Rng& r, LightType type) {
-  Config c;
-  c.set.groups.push_back(randomGroup(r, type));
-  int n = 1 + int(r.below(12));
-  Vec3 centre(4 * r.uniform() - 2, 4 * r.uniform() - 2, 4 * r.uniform() - 2);
-  float spread = r.below(3) == 0 ? 0.01f : 2 * r.uniform();
-  Vec3 axis = randomUnit(r);
-  float coneAngle = r.below(3) == 0 ? 0.0f : kPi * r.uniform();
-  std::vector<detail::Cluster> cl;
-  for (int i = 0; i < n; ++i) {
-    Light l;
-    l.type = type;
-    l.group = 0;
-    l.position = centre + Vec3(r.uniform() - 0.5f, r.uniform() - 0.5f, r.uniform() - 0.5f) * spread;
-    l.direction = type == LightType::Directional ? randomInCone(r, axis, coneAngle * 0.3f)
-                                                 : randomInCone(r, axis, coneAngle);
-    l.intensity = Color(r.uniform(), r.uniform(), r.uniform()) * (0.1f + 5 * r.uniform());
-    c.set.lights.push_back(l);
-    cl.push_back(detail::leafCluster(l, uint32_t(i)));
-  }
-  detail::Cluster acc = cl[0];
-  bool withCone = type == LightType::Oriented || type == LightType::Spot;
-  for (int i = 1; i < n; ++i) acc = detail::mergeClusters(acc, cl[size_t(i)], 0, i, withCone, 7);
-  LightNode& nd = c.node;
-  nd.lo = acc.lo;
-  nd.hi = acc.hi;
-  nd.axis = acc.axis;
-  nd.cosHalfAngle = acc.cosHalfAngle;
-  nd.intensity = acc.intensity;
-  nd.rep = acc.rep;
-  nd.left = 1;
-  nd.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - acc.cosHalfAngle * acc.cosHalfAngle));
-
-  ShadingPoint& sp = c.sp;
-  sp.p = r.below(5) == 0 ? centre : Vec3(6 * r.uniform() - 3, 6 * r.uniform() - 3, 6 * r.uniform() - 3);
-  sp.n = randomUnit(r);
-  Vec3 v = randomUnit(r);
-  if (dot(v, sp.n) < 0) v = -v;
-  sp.r = normalize(reflect(v, sp.n));
-  sp.kd = Color(r.uniform(), r.uniform(), r.uniform());
-  sp.ks = r.below(3) == 0 ? Color(0) : Color(r.uniform(), r.uniform(), r.uniform());
-  const float shininess[] = {0, 0.2f, 1, 5, 25.6f, 128};
-  sp.shininess = shininess[r.below(6)];
-  return c;
-}
-
-Color trueSum(const Config& c) {
-  Color s(0);
-  for (const Light& l : c.set.lights) {
-    Color mg;
-    Vec3 wi;
-    float d;
-    if (lightContribution(l, c.set.groups[l.group], c.sp, mg, wi, d)) s += mg * l.intensity;
-  }
-  return s;
-}
+using test_lights::Config;
+using test_lights::randomConfig;
+using test_lights::randomInCone;
+using test_lights::randomUnit;
+using test_lights::trueSum;
 
 class BoundProperty : public ::testing::TestWithParam<LightType> {};
 
@@ -212,6 +112,52 @@ TEST_P(BoundProperty, LowerBoundIsAtMostTheTrueSum) {
     positive += luminance(lb) > 0;
   }
   EXPECT_GT(positive, 500);  // and is not trivially zero
+}
+
+}  // namespace
+}  // namespace lc::lightcuts
+
+namespace lc::lightcuts {
+namespace {
+
+// `smooth` promises that no light of the cluster sits at a clamp of the contribution: every
+// cosine positive and the attenuation on one side of its corner, within its range.
+TEST_P(BoundProperty, SmoothMeansNoClampWithinTheCluster) {
+  LightType type = GetParam();
+  Rng r(4242, uint64_t(type));
+  int smoothCount = 0;
+  for (int i = 0; i < 20000; ++i) {
+    Config c = randomConfig(r, type);
+    BoundFrames fr(c.sp);
+    Color lower;
+    bool smooth = true;
+    clusterBounds(c.node, type, c.set.groups[0], c.sp, fr, &lower, &smooth);
+    if (!smooth) continue;
+    ++smoothCount;
+    ASSERT_TRUE(type == LightType::Omni || type == LightType::Oriented) << lightTypeName(type);
+    const LightGroup& g = c.set.groups[0];
+    int flat = 0;
+    for (const Light& l : c.set.lights) {
+      Vec3 d = l.position - c.sp.p;
+      float dist = length(d);
+      Vec3 w = d / dist;
+      ASSERT_GT(dot(c.sp.n, w), 0) << "config " << i;
+      if (type == LightType::Oriented) {
+        ASSERT_GT(-dot(l.direction, w), 0) << "config " << i;
+      }
+      if (!g.diffuseOnly && c.sp.hasSpecular()) {
+        ASSERT_GT(dot(c.sp.r, w), 0) << "config " << i;
+      }
+      ASSERT_LE(dist, g.atten.maxDistance);
+      flat += g.atten.derivative(dist) == 0;
+    }
+    ASSERT_TRUE(flat == 0 || flat == int(c.set.lights.size())) << "config " << i;
+  }
+  if (type == LightType::Omni || type == LightType::Oriented) {
+    EXPECT_GT(smoothCount, 500);
+  } else {
+    EXPECT_EQ(smoothCount, 0);
+  }
 }
 
 }  // namespace

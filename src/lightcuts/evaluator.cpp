@@ -33,6 +33,16 @@ CutCriterion parseCutCriterion(const std::string& name) {
 
 const char* cutCriterionName(CutCriterion c) { return c == CutCriterion::Walter ? "walter" : "total"; }
 
+Estimator parseEstimator(const std::string& name) {
+  if (name == "representative") return Estimator::Representative;
+  if (name == "first-order") return Estimator::FirstOrder;
+  throw Error("unknown estimator '" + name + "' (use first-order or representative)");
+}
+
+const char* estimatorName(Estimator e) {
+  return e == Estimator::FirstOrder ? "first-order" : "representative";
+}
+
 namespace {
 
 // The total criterion bounds the root-sum-square of the cut's error spreads by this factor
@@ -43,20 +53,31 @@ namespace {
 // emitters are mostly hidden; docs/LIGHTCUTS.md has the figures).
 constexpr double kTotalFactor = 1.75;
 
-// M * G * V of one light per unit intensity (one shadow ray when the rest is non-zero),
-// and what the shadow ray found (recorded for reconstruction cuts).
+// Clusters of fewer lights are refined rather than probed: up to eight corner rays cost
+// more than refining a small cluster does.
+constexpr uint32_t kProbeMinLights = 16;
+
+// What a representative's shadow ray found (recorded for reconstruction cuts) and, when
+// asked for, what stopped it (for the visibility probes).
+struct ShadowResult {
+  CutVisibility found = CutVisibility::Untested;
+  int blocker = Visibility::kVisible;
+  float tHit = 0;
+};
+
+// M * G * V of one light per unit intensity (one shadow ray when the rest is non-zero).
 inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoint& sp, Visibility& vis,
-                          EvalStats& stats, CutVisibility& found) {
+                          EvalStats& stats, ShadowResult& res, bool wantBlocker = false) {
   Color mg;
   Vec3 wi;
   float dist;
-  found = CutVisibility::Untested;
+  res = ShadowResult{};
   if (!lightContribution(l, g, sp, mg, wi, dist)) return Color(0);
   ++stats.shadowRays;
-  Color v = vis(wi, dist);
-  found = isBlack(v) ? CutVisibility::Occluded
-          : (v.x == 1 && v.y == 1 && v.z == 1) ? CutVisibility::Visible
-                                                : CutVisibility::Partial;
+  Color v = wantBlocker ? vis.trace(wi, dist, res.blocker, res.tHit) : vis(wi, dist);
+  res.found = isBlack(v) ? CutVisibility::Occluded
+              : (v.x == 1 && v.y == 1 && v.z == 1) ? CutVisibility::Visible
+                                                    : CutVisibility::Partial;
   return mg * v;
 }
 
@@ -65,9 +86,9 @@ class BruteForce final : public LightEvaluator {
   explicit BruteForce(const LightSet& lights) : lights_(lights) {}
   EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const override {
     Color sum(0);
-    CutVisibility found;
+    ShadowResult res;
     for (const Light& l : lights_.lights)
-      sum += shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, found) * l.intensity;
+      sum += shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, res) * l.intensity;
     uint32_t n = uint32_t(lights_.lights.size());
     stats.recordCut(n);
     return {sum, n};
@@ -91,7 +112,8 @@ class Lightcuts final : public LightEvaluator {
     Color unit;      // representative's M*G*V per unit intensity
     Color estimate;  // unit * cluster intensity
     float spread;    // error scale used by the total criterion (see below)
-    CutVisibility found;  // what the representative's shadow ray found
+    ShadowResult shadow;  // what the representative's shadow ray found
+    bool firstOrder;  // the estimate is the first-order one (estimate.h)
   };
 
   static uint64_t heapKey(float bound, uint32_t index) {
@@ -158,7 +180,7 @@ class Lightcuts final : public LightEvaluator {
     return cut(sp, vis, stats, &record);
   }
   void mergeSamples(const CutRecord* const* samples, int count, MergedCut& out) const override {
-    mergeCuts(forest_, samples, count, out);
+    mergeCuts(lights_, forest_, samples, count, out);
   }
   EvalResult reconstruct(const ShadingPoint& sp, Visibility& vis, EvalStats& stats,
                          const MergedCut& merged) const override {
@@ -168,7 +190,8 @@ class Lightcuts final : public LightEvaluator {
 
   // The lightcut at sp; with `record`, its nodes are also written there.
   EvalResult cut(const ShadingPoint& sp, Visibility& vis, EvalStats& stats, CutRecord* record) const {
-    static thread_local std::vector<uint64_t> recorded;  // tree << 32 | CutRecord entry
+    // tree << 32 | CutRecord entry, and the entry's first-order factor
+    static thread_local std::vector<std::pair<uint64_t, float>> recorded;
     recorded.clear();
     static thread_local std::vector<uint64_t> heap;
     static thread_local std::vector<CutNode> nodes;
@@ -179,19 +202,22 @@ class Lightcuts final : public LightEvaluator {
     uint32_t cutSize = 0;
     double sumSq = 0;  // sum of the squared spreads of the nodes in the heap
     const bool rss = opt_.criterion == CutCriterion::Total;
+    const bool firstOrder = opt_.estimator == Estimator::FirstOrder;
+    const bool probes = opt_.visibilityProbes;
 
     // Adds a node to the cut: its estimate to the total, and to the heap unless exact.
-    auto record1 = [&](uint32_t t, uint32_t ni, CutVisibility found) {
-      recorded.push_back(uint64_t(t) << 32 | CutRecord::pack(forest_.trees[t].preorder[ni], found));
+    auto record1 = [&](uint32_t t, uint32_t ni, CutVisibility found, bool fo, float factor = 1) {
+      recorded.emplace_back(uint64_t(t) << 32 | CutRecord::pack(forest_.trees[t].preorder[ni], found, fo), factor);
     };
-    auto addNode = [&](uint32_t t, uint32_t ni, const Color& unit, CutVisibility found) {
+    auto addNode = [&](uint32_t t, uint32_t ni, const Color& unit, const ShadowResult& shadow) {
+      const CutVisibility found = shadow.found;
       const LightTree& tree = forest_.trees[t];
       const LightNode& n = tree.nodes[ni];
       Color est = unit * n.intensity;
       total += est;
       ++cutSize;
       if (n.isLeaf()) {
-        if (record) record1(t, ni, found);
+        if (record) record1(t, ni, found, false);
         return;
       }
       ++stats.boundsEvaluated;
@@ -200,19 +226,32 @@ class Lightcuts final : public LightEvaluator {
       // representative is visible is assumed unoccluded, so its estimate is within the
       // upper minus the lower bound of its unshadowed light; otherwise (or when it is
       // partly hidden, which the per-node rule still bounds) within the upper bound.
-      bool visible = rss && !isBlack(unit);
+      bool visible = (rss || firstOrder) && !isBlack(unit);
       Color lower;
-      float b = luminance(clusterBounds(n, tree.type, g, sp, frames, visible ? &lower : nullptr));
+      bool smooth = false;
+      Color upper = clusterBounds(n, tree.type, g, sp, frames, visible ? &lower : nullptr, &smooth);
+      float b = luminance(upper);
       if (b > 0) {
         // A node in the heap may be refined next: fetch its children while we work.
         __builtin_prefetch(&tree.nodes[n.left]);
         __builtin_prefetch(&tree.nodes[n.left + 1]);
         float spread = visible ? std::max(0.0f, b - luminance(lower)) : b;
+        // The first-order estimate (estimate.h) where the contribution is smooth over the
+        // cluster and its representative unoccluded, kept within the bounds. Its spread
+        // stays upper minus lower: what it cannot see, a partly hidden cluster, is what
+        // that spread also stands for.
+        const bool fo = firstOrder && smooth && found == CutVisibility::Visible;
+        if (fo) {
+          Color u = firstOrderUnit(lights_.lights[n.rep], g, sp, tree.moments[ni], unit) * n.intensity;
+          Color corrected = vmin(vmax(u, lower), upper);
+          total += corrected - est;
+          est = corrected;
+        }
         sumSq += double(spread) * spread;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
-        nodes.push_back(CutNode{t, ni, unit, est, spread, found});
+        nodes.push_back(CutNode{t, ni, unit, est, spread, shadow, fo});
       } else if (record) {
-        record1(t, ni, found);
+        record1(t, ni, found, false);
       }
     };
 
@@ -220,9 +259,9 @@ class Lightcuts final : public LightEvaluator {
       const LightTree& tree = forest_.trees[t];
       if (tree.nodes.empty()) continue;
       const LightNode& root = tree.nodes[0];
-      CutVisibility found;
-      Color unit = shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats, found);
-      addNode(t, 0, unit, found);
+      ShadowResult shadow;
+      Color unit = shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats, shadow, probes);
+      addNode(t, 0, unit, shadow);
     }
     const float eps = opt_.errorRatio;
     const double rssFactor2 = kTotalFactor * kTotalFactor;
@@ -234,33 +273,49 @@ class Lightcuts final : public LightEvaluator {
       heapPop(heap);
       const CutNode cn = nodes[uint32_t(top)];
       sumSq = std::max(0.0, sumSq - double(cn.spread) * cn.spread);
-      total -= cn.estimate;
-      --cutSize;
       const LightTree& tree = forest_.trees[cn.tree];
       const LightGroup& g = lights_.groups[tree.group];
+      if (probes && cn.shadow.blocker >= 0 && tree.moments[cn.node].lights >= kProbeMinLights &&
+          hiddenCluster(tree.nodes[cn.node], tree.type, sp, cn.shadow, vis, stats)) {
+        // Its representative is hidden, and so is the whole cluster: it stays in the cut,
+        // exactly 0, instead of being refined down to its lights.
+        ++stats.hiddenClusters;
+        if (record) record1(cn.tree, cn.node, CutVisibility::Occluded, false);
+        continue;
+      }
+      total -= cn.estimate;
+      --cutSize;
       const LightNode& n = tree.nodes[cn.node];
       for (uint32_t c = n.left; c <= n.left + 1; ++c) {
         uint32_t rep = tree.nodes[c].rep;
         // The child that shares the parent's representative reuses its shadow ray.
-        CutVisibility found = cn.found;
-        Color unit = rep == n.rep ? cn.unit : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, found);
-        addNode(cn.tree, c, unit, found);
+        ShadowResult shadow = cn.shadow;
+        Color unit = rep == n.rep ? cn.unit : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, shadow, probes);
+        addNode(cn.tree, c, unit, shadow);
       }
     }
     if (record) {
       // The cut: the nodes left in the heap, and the exact ones recorded as they came.
       for (uint64_t key : heap) {
         const CutNode& cn = nodes[uint32_t(key)];
-        record1(cn.tree, cn.node, cn.found);
+        float factor = 1;
+        if (cn.firstOrder) {
+          float raw = luminance(cn.unit * forest_.trees[cn.tree].nodes[cn.node].intensity);
+          factor = raw > 0 ? std::clamp(luminance(cn.estimate) / raw, 0.5f, 2.0f) : 1.0f;
+        }
+        record1(cn.tree, cn.node, cn.shadow.found, cn.firstOrder, factor);
       }
-      std::sort(recorded.begin(), recorded.end());
+      std::sort(recorded.begin(), recorded.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
       record->clear();
       record->valid = true;
+      record->point = sp.p;
       record->entries.resize(recorded.size());
+      record->factor.resize(recorded.size());
       record->treeBegin.assign(forest_.trees.size() + 1, uint32_t(recorded.size()));
       for (size_t i = recorded.size(); i-- > 0;) {
-        record->entries[i] = uint32_t(recorded[i]);
-        record->treeBegin[recorded[i] >> 32] = uint32_t(i);
+        record->entries[i] = uint32_t(recorded[i].first);
+        record->factor[i] = recorded[i].second;
+        record->treeBegin[recorded[i].first >> 32] = uint32_t(i);
       }
       // Trees with no entries begin where the next one does.
       for (size_t t = forest_.trees.size(); t-- > 0;)
@@ -272,6 +327,38 @@ class Lightcuts final : public LightEvaluator {
   Method method() const override { return Method::Lightcuts; }
 
  private:
+  // Whether the whole cluster is provably hidden from sp: its representative's shadow ray
+  // (`rep`) and those toward the corners of its bounding box all meet one convex opaque
+  // object, nearer than the box. The directions whose ray meets a convex object within a
+  // distance T form a convex cone, so every direction into the box (in the hull of the
+  // corners' directions) meets it within the corners' largest distance, nearer than any
+  // light of the box: the cluster's visibility is 0, and so is its error. A corner behind
+  // the surface (whose ray the surface itself would stop), or blocked by anything else (a
+  // wall, glass, a non-convex mesh), means no.
+  bool hiddenCluster(const LightNode& n, LightType type, const ShadingPoint& sp, const ShadowResult& rep,
+                     Visibility& vis, EvalStats& stats) const {
+    if (type == LightType::Directional) return false;
+    const float dMin = length(vmax(vmax(n.lo - sp.p, sp.p - n.hi), Vec3(0.0f)));
+    if (rep.blocker < 0 || !(rep.tHit < dMin)) return false;
+    ++stats.probedClusters;
+    for (int k = 0; k < 8; ++k) {
+      // A flat box has only four distinct corners: the others repeat them.
+      if (((k & 1) && n.lo.x == n.hi.x) || ((k & 2) && n.lo.y == n.hi.y) || ((k & 4) && n.lo.z == n.hi.z)) continue;
+      Vec3 corner((k & 1) ? n.hi.x : n.lo.x, (k & 2) ? n.hi.y : n.lo.y, (k & 4) ? n.hi.z : n.lo.z);
+      Vec3 d = corner - sp.p;
+      float dist = length(d);
+      Vec3 wi = d / dist;
+      if (!(dot(wi, sp.n) > 0)) return false;
+      ++stats.shadowRays;
+      ++stats.probeRays;
+      int blocker;
+      float tHit;
+      vis.trace(wi, dist, blocker, tHit);
+      if (blocker != rep.blocker || !(tHit < dMin)) return false;
+    }
+    return true;
+  }
+
   const LightSet& lights_;
   const LightForest& forest_;
   CutOptions opt_;
@@ -332,7 +419,7 @@ class SeedCuts final : public LightEvaluator {
                   Visibility& vis, EvalStats& stats, bool& blocked) const {
     const LightNode& n = tree.nodes[ni];
     blocked = false;
-    CutVisibility found;
+    ShadowResult found;
     if (n.isLeaf()) return shadowedUnit(lights_.lights[n.rep], g, sp, vis, stats, found) * n.intensity;
     const SeedNodeData& sd = tree.seed[ni];
     Light syn;

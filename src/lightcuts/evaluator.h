@@ -3,7 +3,11 @@
 //   brute      every light, exactly: the reference.
 //   lightcuts  Walter et al. 2005: a cut through the light tree chosen per point by a
 //              max-heap on the clusters' error upper bounds, refined until every bound is
-//              below errorRatio times the current estimate (or maxCut nodes).
+//              below errorRatio times the current estimate (or maxCut nodes). Two
+//              extensions, each with an option to turn it off: clusters are estimated to
+//              first order where that is valid (estimate.h), and a cluster whose
+//              representative is hidden is first tested for being hidden as a whole
+//              (visibility probes, below) instead of being refined down to its lights.
 //              Its cuts can be recorded at sparse samples and rebuilt between them
 //              (reconstruction cuts, reconstruction.h).
 //   seed       the course project's traversal: descend while a node's error radius over
@@ -16,6 +20,7 @@
 #include <memory>
 #include <string>
 
+#include "lightcuts/estimate.h"
 #include "lightcuts/light_tree.h"
 #include "lightcuts/reconstruction.h"
 #include "lightcuts/shading.h"
@@ -44,6 +49,13 @@ struct CutOptions {
   float errorRatio = 0.02f;  // --error: relative error threshold
   int maxCut = 4000;         // --max-cut: most nodes in one cut
   CutCriterion criterion = CutCriterion::Total;
+  Estimator estimator = Estimator::FirstOrder;  // --estimator (estimate.h)
+  // --visibility-probes: before a cluster of 16 lights or more whose representative is
+  // hidden is refined, shadow rays go to the corners of its bounding box; when they all
+  // meet the convex object that hides the representative, nearer than the box, the
+  // cluster is provably hidden (Visibility::trace) and stays in the cut as 0, with no
+  // error, instead of being refined down to every light (the umbra of an emitter).
+  bool visibilityProbes = true;
 };
 
 // Counters summed over shading points (per thread, then merged).
@@ -54,6 +66,11 @@ struct EvalStats {
   uint64_t shadowRays = 0;
   uint64_t boundsEvaluated = 0;
   uint64_t reconstructedPoints = 0;  // shading points given a reconstruction cut
+  uint64_t probedClusters = 0;       // clusters tested for being hidden as a whole
+  uint64_t probeRays = 0;            // the shadow rays those tests cast (in shadowRays too)
+  uint64_t hiddenClusters = 0;       // clusters kept in a cut as hidden by their probes
+  uint64_t groupProbes = 0;          // rays testing groups of borrowed-visible nodes (reconstruction.h)
+  uint64_t failedGroupProbes = 0;    // those groups found hidden where every sample saw them
   std::array<uint64_t, kHistogramBuckets> cutHistogram{};
 
   void recordCut(uint32_t size) {
@@ -69,6 +86,11 @@ struct EvalStats {
     shadowRays += o.shadowRays;
     boundsEvaluated += o.boundsEvaluated;
     reconstructedPoints += o.reconstructedPoints;
+    probedClusters += o.probedClusters;
+    probeRays += o.probeRays;
+    hiddenClusters += o.hiddenClusters;
+    groupProbes += o.groupProbes;
+    failedGroupProbes += o.failedGroupProbes;
     for (size_t i = 0; i < cutHistogram.size(); ++i) cutHistogram[i] += o.cutHistogram[i];
   }
 };

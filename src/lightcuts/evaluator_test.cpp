@@ -156,7 +156,8 @@ TEST(Lightcuts, RefinesTheLargestBoundFirst) {
       add(t.nodes[ni].left + 1);
     }
     for (; !heap.empty(); heap.pop()) expect += unit(heap.top().second) * t.nodes[heap.top().second].intensity;
-    auto lcut = makeLightcuts(s, f, CutOptions{0.0f, int(maxCut), CutCriterion::Walter});
+    // The representative's estimate, as the replay computes it.
+    auto lcut = makeLightcuts(s, f, CutOptions{0.0f, int(maxCut), CutCriterion::Walter, Estimator::Representative});
     EvalStats st;
     EvalResult r = lcut->evaluate(sp, vis, st);
     EXPECT_EQ(r.cutSize, size) << "max cut " << maxCut;
@@ -215,6 +216,97 @@ TEST(Methods, ParseNames) {
   EXPECT_EQ(parseMethod("brute"), Method::Brute);
   EXPECT_EQ(parseMethod("seed"), Method::Seed);
   EXPECT_THROW(parseMethod("fast"), Error);
+}
+
+}  // namespace
+}  // namespace lc::lightcuts
+
+namespace lc::lightcuts {
+namespace {
+
+// A convex opaque ball (object 7) between the shading point and its lights.
+struct Ball : Visibility {
+  Vec3 from, centre;
+  float radius;
+  int hits = 0;
+  Ball(Vec3 f, Vec3 c, float r) : from(f), centre(c), radius(r) {}
+  // Distance along wi to the ball, or infinity.
+  float distance(const Vec3& wi) const {
+    Vec3 oc = from - centre;
+    float b = dot(oc, wi), c = dot(oc, oc) - radius * radius;
+    float disc = b * b - c;
+    if (disc < 0) return kInf;
+    float t = -b - std::sqrt(disc);
+    return t > 0 ? t : kInf;
+  }
+  Color operator()(const Vec3& wi, float dist) override { return distance(wi) < dist ? Color(0) : Color(1); }
+  Color trace(const Vec3& wi, float dist, int& blocker, float& tHit) override {
+    tHit = distance(wi);
+    blocker = tHit < dist ? 7 : kVisible;
+    return blocker == 7 ? Color(0) : Color(1);
+  }
+};
+
+// The same, as an occluder of unknown shape: probes can prove nothing.
+struct UnknownBall : Ball {
+  using Ball::Ball;
+  Color trace(const Vec3& wi, float dist, int& blocker, float& tHit) override {
+    return Visibility::trace(wi, dist, blocker, tHit);
+  }
+};
+
+CutOptions withProbes(bool on, float error = 0.02f) {
+  CutOptions o;
+  o.errorRatio = error;
+  o.maxCut = 1 << 20;
+  o.visibilityProbes = on;
+  return o;
+}
+
+// Every light hidden behind a convex ball: the point gets nothing, and a cluster proven
+// hidden is not refined; without probes (or with an occluder it cannot prove convex) the
+// cut refines to every light, since no bound ever falls below 2% of nothing.
+TEST(VisibilityProbes, AHiddenCloudStaysOneCluster) {
+  LightSet s = cloud(2000, LightType::Omni, 21);
+  LightForest f = buildLightForest(s);
+  ShadingPoint sp = point(Vec3(0, 0, 0));
+  Ball ball(sp.p, Vec3(0, 0.5f, 0), 0.47f);
+  auto on = makeLightcuts(s, f, withProbes(true));
+  auto off = makeLightcuts(s, f, withProbes(false));
+  EvalStats son, soff, sunk;
+  EvalResult a = on->evaluate(sp, ball, son);
+  EvalResult b = off->evaluate(sp, ball, soff);
+  UnknownBall unknown(sp.p, Vec3(0, 0.5f, 0), 0.47f);
+  EvalResult c = on->evaluate(sp, unknown, sunk);
+  EXPECT_EQ(luminance(a.radiance), 0.0f);
+  EXPECT_EQ(luminance(b.radiance), 0.0f);
+  EXPECT_EQ(son.hiddenClusters, 1u);
+  EXPECT_EQ(a.cutSize, 1u);
+  EXPECT_EQ(b.cutSize, 2000u);
+  EXPECT_EQ(sunk.hiddenClusters, 0u);
+  EXPECT_EQ(c.cutSize, 2000u);
+}
+
+// Partly hidden clouds: with a zero threshold the cut refines everything it cannot prove
+// hidden, so it must equal brute force exactly; proven-hidden clusters must have been
+// truly hidden.
+TEST(VisibilityProbes, ProvenHiddenClustersAreExact) {
+  for (LightType type : {LightType::Omni, LightType::Oriented}) {
+    LightSet s = cloud(3000, type, 22);
+    LightForest f = buildLightForest(s);
+    auto bf = makeBruteForce(s);
+    auto lcut = makeLightcuts(s, f, withProbes(true, 0.0f));
+    EvalStats st, sb;
+    for (int i = 0; i < 12; ++i) {
+      ShadingPoint sp = point(Vec3(0.3f * float(i) - 1.8f, 0, 0.1f * float(i) - 0.5f));
+      Ball ball(sp.p, sp.p + Vec3(0.2f * float(i % 4) - 0.3f, 1.0f, 0.1f), 0.35f);
+      Color want = bf->evaluate(sp, ball, sb).radiance;
+      Color got = lcut->evaluate(sp, ball, st).radiance;
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-5f * (want[c] + 1e-6f)) << i;
+    }
+    EXPECT_GT(st.hiddenClusters, 0u) << lightTypeName(type);
+    EXPECT_LT(st.cutNodes, sb.cutNodes) << lightTypeName(type);
+  }
 }
 
 }  // namespace

@@ -15,6 +15,7 @@ size_t LightForest::memoryBytes() const {
   size_t b = 0;
   for (const LightTree& t : trees)
     b += t.nodes.size() * sizeof(LightNode) + t.seed.size() * sizeof(SeedNodeData) +
+         t.moments.size() * sizeof(NodeMoments) +
          t.preorder.size() * sizeof(uint32_t);
   return b;
 }
@@ -88,11 +89,35 @@ struct GroupKey {
 
 }  // namespace
 
+void computeMoments(const LightSet& lights, LightTree& tree) {
+  // Bottom-up: children always have larger indices than their parent in our layout, so a
+  // reverse sweep visits children first.
+  std::vector<NodeMoments>& m = tree.moments;
+  m.assign(tree.nodes.size(), NodeMoments{});
+  for (size_t i = tree.nodes.size(); i-- > 0;) {
+    const LightNode& n = tree.nodes[i];
+    if (n.isLeaf()) {
+      const Light& l = lights.lights[n.rep];
+      m[i].centroid = l.type == LightType::Directional ? -l.direction : l.position;
+      m[i].meanAxis = l.direction;
+      continue;
+    }
+    float wa = luminance(tree.nodes[n.left].intensity), wb = luminance(tree.nodes[n.left + 1].intensity);
+    float w = wa + wb;
+    if (!(w > 0)) { wa = wb = 0.5f; w = 1; }
+    const NodeMoments& a = m[n.left];
+    const NodeMoments& b = m[n.left + 1];
+    m[i].centroid = (a.centroid * wa + b.centroid * wb) / w;
+    m[i].meanAxis = (a.meanAxis * wa + b.meanAxis * wb) / w;
+    m[i].lights = a.lights + b.lights;
+  }
+}
+
 void computeSeedData(const LightSet& lights, LightTree& tree) {
-  // Bottom-up. Children always have larger indices than their parent in our layout, so a
-  // reverse sweep visits children first. The mean distance to the centroid is exact for
-  // leaves and bounded above through the triangle inequality for inner nodes; the seed
-  // builder overwrites it with exact values.
+  // Bottom-up, as computeMoments. The mean distance to the centroid is exact for leaves and
+  // bounded above through the triangle inequality for inner nodes; the seed builder
+  // overwrites it with exact values.
+  if (tree.moments.size() != tree.nodes.size()) computeMoments(lights, tree);
   std::vector<SeedNodeData>& sd = tree.seed;
   std::vector<float> spread(tree.nodes.size(), 0.0f);
   sd.assign(tree.nodes.size(), SeedNodeData{});
@@ -103,27 +128,23 @@ void computeSeedData(const LightSet& lights, LightTree& tree) {
   for (size_t i = tree.nodes.size(); i-- > 0;) {
     const LightNode& n = tree.nodes[i];
     SeedNodeData& d = sd[i];
+    const NodeMoments& mo = tree.moments[i];
+    d.position = mo.centroid;
     if (n.isLeaf()) {
-      const Light& l = lights.lights[n.rep];
-      d.position = l.type == LightType::Directional ? -l.direction : l.position;
-      d.direction = l.direction;
+      d.direction = mo.meanAxis;
       d.error = 0;
       continue;
     }
-    const LightNode& a = tree.nodes[n.left];
-    const LightNode& b = tree.nodes[n.left + 1];
     const SeedNodeData& da = sd[n.left];
+    d.direction = length2(mo.meanAxis) > 0 ? normalize(mo.meanAxis) : da.direction;
     const SeedNodeData& db = sd[n.left + 1];
-    float wa = luminance(a.intensity), wb = luminance(b.intensity);
+    float wa = luminance(tree.nodes[n.left].intensity), wb = luminance(tree.nodes[n.left + 1].intensity);
     float w = wa + wb;
     if (!(w > 0)) { wa = wb = 0.5f; w = 1; }
-    d.position = (da.position * wa + db.position * wb) / w;
-    Vec3 dir = da.direction * wa + db.direction * wb;
-    d.direction = length2(dir) > 0 ? normalize(dir) : da.direction;
     float meanDist = (wa * (da.error / (1 + spread[n.left]) + length(da.position - d.position)) +
                       wb * (db.error / (1 + spread[n.left + 1]) + length(db.position - d.position))) / w;
     Color cm = chroma(n.intensity);
-    Vec3 ca = vabs(chroma(a.intensity) - cm), cb = vabs(chroma(b.intensity) - cm);
+    Vec3 ca = vabs(chroma(tree.nodes[n.left].intensity) - cm), cb = vabs(chroma(tree.nodes[n.left + 1].intensity) - cm);
     spread[i] = (wa * (spread[n.left] + ca.x + ca.y + ca.z) + wb * (spread[n.left + 1] + cb.x + cb.y + cb.z)) / w;
     d.error = meanDist * (1 + spread[i]);
   }

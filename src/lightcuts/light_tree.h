@@ -42,11 +42,20 @@ struct SeedNodeData {
   float error;     // weighted mean distance to the centroid, scaled by the colour spread
 };
 
+// Per-node first moments of the cluster's lights, weighted by luminance: what the
+// first-order estimate of a cluster (estimate.h) subtracts from its representative's.
+struct NodeMoments {
+  Vec3 centroid;  // mean position (directional trees: mean direction toward the light)
+  Vec3 meanAxis;  // mean normal/axis, not normalised (oriented and spot lights)
+  uint32_t lights = 1;  // how many lights the node holds
+};
+
 struct LightTree {
   LightType type = LightType::Omni;
   uint16_t group = 0;
   std::vector<LightNode> nodes;  // nodes[0] is the root
   std::vector<SeedNodeData> seed;  // parallel to nodes
+  std::vector<NodeMoments> moments;  // parallel to nodes
   // Parallel to nodes: each node's position in a depth-first walk that visits the left
   // child (n.left) before the right one, so a subtree is a contiguous range. Reconstruction
   // cuts (reconstruction.h) compare cuts of different points by it.
@@ -102,7 +111,12 @@ LightTree buildSeedTree(const LightSet& lights, const std::vector<uint32_t>& ind
 // Fills LightTree::preorder (buildLightForest calls it).
 void computePreorder(LightTree& tree);
 
-// Fills LightTree::seed from the finished nodes (centroids, mean directions, errors).
+// Fills LightTree::moments from the finished nodes (buildLightForest calls it).
+void computeMoments(const LightSet& lights, LightTree& tree);
+
+
+// Fills LightTree::seed from the finished nodes and their moments (centroids, mean
+// directions, errors).
 void computeSeedData(const LightSet& lights, LightTree& tree);
 
 }  // namespace lc::lightcuts

@@ -11,17 +11,54 @@ namespace {
 constexpr int kMaxSamples = 4;
 constexpr uint8_t kAbove = 0xff;  // the sample refined this node: its cut lies below
 
+// A group of borrowed-visible nodes is checked with a probe ray when it holds more than
+// this share of the point's light.
+constexpr float kGroupShare = 0.02f;
+
+// A coarser cut is borrowed only from samples this many times closer to each other than
+// to the cluster (squared).
+constexpr float kCoarsenRatio2 = 8.0f * 8.0f;
+
+inline float distance2Box(const LightNode& n, const Vec3& p) {
+  Vec3 d = vmax(vmax(n.lo - p, p - n.hi), Vec3(0.0f));
+  return dot(d, d);
+}
+
+constexpr uint8_t kFirstOrderBit = 4;
+constexpr uint8_t kStateMask = 7;  // visibility and kFirstOrderBit
+
 struct Item {
   uint32_t node;
-  uint8_t state[kMaxSamples];  // per sample: kAbove or the CutVisibility it inherits
+  // Per sample: kAbove, or the CutVisibility it inherits, with kFirstOrderBit when that
+  // cut node used its first-order estimate (then so may every node below it: a part of
+  // a cluster over which the contribution is smooth is smooth too).
+  uint8_t state[kMaxSamples];
+  // Bit i: sample i's cut holds this very node (its entry is the one before its cursor).
+  uint8_t exact;
 };
 
 }  // namespace
 
-void mergeCuts(const LightForest& forest, const CutRecord* const* samples, int count, MergedCut& out) {
+void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecord* const* samples, int count,
+               MergedCut& out) {
   out.clear();
   count = std::clamp(count, 0, kMaxSamples);
   static thread_local std::vector<Item> stack;
+  // Per sample: how many of its entries before each one are not visible with a
+  // first-order estimate, so that any run of entries can be checked at once.
+  static thread_local std::vector<uint32_t> rough[kMaxSamples];
+  for (int i = 0; i < count; ++i) {
+    const std::vector<uint32_t>& e = samples[i]->entries;
+    rough[i].resize(e.size() + 1);
+    rough[i][0] = 0;
+    for (size_t k = 0; k < e.size(); ++k)
+      rough[i][k + 1] = rough[i][k] + !(CutRecord::visibilityOf(e[k]) == CutVisibility::Visible &&
+                                         CutRecord::firstOrderOf(e[k]));
+  }
+  // The samples' spread: the largest distance between two of them, squared.
+  float spread2 = 0;
+  for (int i = 0; i < count; ++i)
+    for (int j = i + 1; j < count; ++j) spread2 = std::max(spread2, length2(samples[i]->point - samples[j]->point));
   for (uint32_t t = 0; t < forest.trees.size(); ++t) {
     const LightTree& tree = forest.trees[t];
     if (tree.nodes.empty()) continue;
@@ -33,7 +70,7 @@ void mergeCuts(const LightForest& forest, const CutRecord* const* samples, int c
       end[i] = samples[i]->treeBegin[t + 1];
     }
     stack.clear();
-    stack.push_back(Item{0, {kAbove, kAbove, kAbove, kAbove}});
+    stack.push_back(Item{0, {kAbove, kAbove, kAbove, kAbove}, 0});
     while (!stack.empty()) {
       Item it = stack.back();
       stack.pop_back();
@@ -44,9 +81,11 @@ void mergeCuts(const LightForest& forest, const CutRecord* const* samples, int c
         if (it.state[i] != kAbove) continue;
         const uint32_t* e = samples[i]->entries.data();
         uint32_t c = cursor[i];
-        while (c < end[i] && (e[c] >> 2) < pre) ++c;  // skips nodes of subtrees not walked
-        if (c < end[i] && (e[c] >> 2) == pre) {
-          it.state[i] = uint8_t(e[c] & 3);
+        while (c < end[i] && CutRecord::preorderOf(e[c]) < pre) ++c;  // skips nodes of subtrees not walked
+        if (c < end[i] && CutRecord::preorderOf(e[c]) == pre) {
+          it.state[i] = uint8_t(uint8_t(CutRecord::visibilityOf(e[c])) |
+                                (CutRecord::firstOrderOf(e[c]) ? kFirstOrderBit : 0));
+          it.exact |= uint8_t(1u << i);
           ++c;
         } else if (n.isLeaf() || c >= end[i]) {
           it.state[i] = uint8_t(CutVisibility::Untested);  // a record of another forest
@@ -56,6 +95,39 @@ void mergeCuts(const LightForest& forest, const CutRecord* const* samples, int c
         cursor[i] = c;
       }
       if (above) {
+        // Samples disagree on how fine the cut is here. Where every sample's cut under this
+        // node is visible with first-order estimates, and one sample kept the node itself
+        // so, the coarser cut will do.
+        const uint8_t vf = uint8_t(CutVisibility::Visible) | kFirstOrderBit;
+        bool kept = false, ok = true;
+        const uint32_t last = pre + 2 * tree.moments[it.node].lights - 1;  // the subtree's preorder range
+        uint32_t past[kMaxSamples];  // per refining sample: its first entry after the subtree
+        for (int i = 0; i < count && ok; ++i) {
+          if (it.state[i] == kAbove) continue;
+          kept |= it.state[i] == vf && (it.exact >> i & 1);
+          ok = it.state[i] == vf;
+        }
+        // ... as long as the samples are close together seen from the cluster: the coarser
+        // cut was chosen for the sample that kept it.
+        ok = ok && kept && distance2Box(n, samples[0]->point) >= kCoarsenRatio2 * spread2;
+        for (int i = 0; i < count && ok; ++i) {
+          if (it.state[i] != kAbove) continue;
+          const uint32_t* e = samples[i]->entries.data();
+          past[i] = uint32_t(std::lower_bound(e + cursor[i], e + end[i], last,
+                                              [](uint32_t en, uint32_t p) { return CutRecord::preorderOf(en) < p; }) - e);
+          ok = rough[i][past[i]] == rough[i][cursor[i]];
+        }
+        if (ok) {
+          for (int i = 0; i < count; ++i) {
+            if (it.state[i] != kAbove) continue;
+            cursor[i] = past[i];
+            it.state[i] = vf;
+          }
+          above = false;
+        }
+      }
+      if (above) {
+        it.exact = 0;  // the children inherit states, not the entries
         Item r = it;
         r.node = n.left + 1;
         stack.push_back(r);
@@ -63,9 +135,16 @@ void mergeCuts(const LightForest& forest, const CutRecord* const* samples, int c
         stack.push_back(it);  // left on top: the walk stays in preorder
         continue;
       }
-      int visible = 0, occluded = 0, partial = 0;
+      int visible = 0, occluded = 0, partial = 0, firstOrder = 0, exact = 0;
+      float factorSum = 0;
       for (int i = 0; i < count; ++i) {
-        auto s = CutVisibility(it.state[i]);
+        firstOrder += (it.state[i] & kFirstOrderBit) != 0;
+        if (it.exact >> i & 1) {
+          const std::vector<float>& f = samples[i]->factor;
+          ++exact;
+          factorSum += cursor[i] - 1 < f.size() ? f[cursor[i] - 1] : 1.0f;
+        }
+        auto s = CutVisibility(it.state[i] & 3);
         visible += s == CutVisibility::Visible;
         occluded += s == CutVisibility::Occluded;
         partial += s == CutVisibility::Partial;
@@ -75,24 +154,74 @@ void mergeCuts(const LightForest& forest, const CutRecord* const* samples, int c
         continue;
       }
       bool needsRay = occluded > 0 || partial > 0 || visible == 0;
-      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, tree.group, needsRay});
+      const float factor = firstOrder == count && exact > 0 ? factorSum / float(exact) : 1.0f;
+      const bool batched = !needsRay && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
+      if (batched) {
+        out.batch.add(lights.lights[n.rep], lights.groups[tree.group], n.intensity * factor);
+        out.batchNodes.push_back(uint32_t(out.nodes.size()));
+      }
+      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, tree.group, needsRay, batched, factor, t, it.node});
     }
+  }
+  for (size_t g = 0; g < out.batchNodes.size(); g += MergedCut::kGroupSize) {
+    uint32_t best = out.batchNodes[g];
+    for (size_t i = g; i < std::min(out.batchNodes.size(), g + MergedCut::kGroupSize); ++i)
+      if (luminance(out.nodes[out.batchNodes[i]].intensity) > luminance(out.nodes[best].intensity))
+        best = out.batchNodes[i];
+    out.groupProbe.push_back(best);
   }
 }
 
+namespace {
+
+// A node with one shadow ray: its representative's contribution, times the samples'
+// first-order factor where it is unoccluded.
+Color withRay(const LightSet& lights, const MergedCut::Node& node, const ShadingPoint& sp, Visibility& vis,
+              EvalStats& stats) {
+  Color mg;
+  Vec3 wi;
+  float dist;
+  if (!lightContribution(lights.lights[node.rep], lights.groups[node.group], sp, mg, wi, dist)) return Color(0);
+  ++stats.shadowRays;
+  Color v = vis(wi, dist);
+  float f = v.x == 1 && v.y == 1 && v.z == 1 ? node.factor : 1.0f;
+  return mg * v * (node.intensity * f);
+}
+
+}  // namespace
+
 ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& cut, const ShadingPoint& sp,
                                        Visibility& vis, EvalStats& stats) {
+  // The nodes that need a ray, one by one; then the batched nodes four at a time, group
+  // by group.
   Color total(0);
-  for (const MergedCut::Node& node : cut.nodes) {
+  for (const MergedCut::Node& node : cut.nodes)
+    if (!node.batched) total += withRay(lights, node, sp, vis, stats);
+  const size_t groups = cut.groupProbe.size();
+  static thread_local std::vector<Color> groupSum;
+  groupSum.resize(groups);
+  constexpr size_t kBlocks = MergedCut::kGroupSize / 4;
+  for (size_t g = 0; g < groups; ++g) {
+    groupSum[g] = evaluateBatch(cut.batch, sp, g * kBlocks, (g + 1) * kBlocks);
+    total += groupSum[g];
+  }
+  // A group that holds a share of the light worth checking gets its probe's ray; hidden,
+  // the group's nodes get one each.
+  const float worth = kGroupShare * luminance(total);
+  for (size_t g = 0; g < groups; ++g) {
+    if (!(luminance(groupSum[g]) > worth)) continue;
+    const MergedCut::Node& probe = cut.nodes[cut.groupProbe[g]];
     Color mg;
     Vec3 wi;
     float dist;
-    if (!lightContribution(lights.lights[node.rep], lights.groups[node.group], sp, mg, wi, dist)) continue;
-    if (node.needsRay) {
-      ++stats.shadowRays;
-      mg *= vis(wi, dist);
-    }
-    total += mg * node.intensity;
+    if (!lightContribution(lights.lights[probe.rep], lights.groups[probe.group], sp, mg, wi, dist)) continue;
+    ++stats.shadowRays;
+    ++stats.groupProbes;
+    if (!isBlack(vis(wi, dist))) continue;
+    ++stats.failedGroupProbes;
+    total -= groupSum[g];
+    for (size_t i = g * MergedCut::kGroupSize; i < std::min(cut.batchNodes.size(), (g + 1) * MergedCut::kGroupSize); ++i)
+      total += withRay(lights, cut.nodes[cut.batchNodes[i]], sp, vis, stats);
   }
   uint32_t cutSize = uint32_t(cut.nodes.size()) + cut.occluded;
   stats.recordCut(cutSize);

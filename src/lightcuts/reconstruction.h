@@ -9,18 +9,23 @@
 //     estimate at this point, without a shadow ray;
 //   - the samples disagree, or the path went through glass: the estimate with one shadow
 //     ray, as lightcuts would.
-// So the point's cut is at least as fine as each of its samples' cuts, its material and
-// geometric terms are its own (textures, normals, highlights stay sharp), and only
-// visibility is borrowed, where all its samples agree. Shadow rays drop from the cut size
-// to those of nodes near shadow boundaries. The caller decides which samples are similar
-// enough to use (the renderer: the same surface, normals within ~25 degrees); a feature
-// thinner than the sample spacing that all samples miss is the method's blind spot.
+// Where the samples' cuts differ, the point takes the finer one, except where every
+// sample saw the node (or all of its part of the cut below it) visible with first-order
+// estimates (estimate.h), smooth and unoccluded: there the coarser cut's second-order
+// error is small at the point too, and the coarser is kept. The point's material and
+// geometric terms are its own (textures, normals, highlights stay sharp); only visibility
+// and the choice of clusters are borrowed, where all its samples agree. Shadow rays drop
+// from the cut size to those of nodes near shadow boundaries. The caller decides which
+// samples are similar enough to use (the renderer: the same surface, normals within ~25
+// degrees); a feature thinner than the sample spacing that all samples miss is the
+// method's blind spot.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
 #include "lightcuts/light_tree.h"
+#include "lightcuts/merged_batch.h"
 #include "lightcuts/shading.h"
 #include "scene/light.h"
 
@@ -37,18 +42,30 @@ enum class CutVisibility : uint8_t {
 };
 
 // A sample's cut: per tree, its nodes in preorder (LightTree::preorder) with their
-// CutVisibility, packed as preorder << 2 | visibility.
+// CutVisibility and whether the node's first-order estimate was used (estimate.h), packed
+// as preorder << 3 | firstOrder << 2 | visibility.
 struct CutRecord {
   std::vector<uint32_t> entries;
+  // Per entry: the first-order estimate over the representative's (both unshadowed), 1
+  // where the first-order estimate was not used. A point near the sample borrows it: the
+  // correction changes with the point far more slowly than the contribution does.
+  std::vector<float> factor;
   std::vector<uint32_t> treeBegin;  // entries of tree t: [treeBegin[t], treeBegin[t + 1])
+  Vec3 point;                       // the sample's shading point
   bool valid = false;               // false: no cut was recorded (the caller's miss)
 
   void clear() {
     entries.clear();
+    factor.clear();
     treeBegin.clear();
     valid = false;
   }
-  static uint32_t pack(uint32_t preorder, CutVisibility v) { return preorder << 2 | uint32_t(v); }
+  static uint32_t pack(uint32_t preorder, CutVisibility v, bool firstOrder = false) {
+    return preorder << 3 | uint32_t(firstOrder) << 2 | uint32_t(v);
+  }
+  static uint32_t preorderOf(uint32_t entry) { return entry >> 3; }
+  static CutVisibility visibilityOf(uint32_t entry) { return CutVisibility(entry & 3); }
+  static bool firstOrderOf(uint32_t entry) { return (entry >> 2 & 1) != 0; }
 };
 
 // The cut a point rebuilds from a set of samples; it depends on the samples only, so every
@@ -59,17 +76,35 @@ struct MergedCut {
     uint32_t rep;     // its representative light
     uint16_t group;
     bool needsRay;    // the samples disagree, went through glass, or tested nothing
+    bool batched;     // also in `batch` (no ray, an omni or oriented light)
+    // The first-order factor (CutRecord::factor) of the samples whose cut holds the node,
+    // averaged, when every sample used first-order estimates there; else 1.
+    float factor;
+    uint32_t tree, node;  // where it is in the forest
   };
   std::vector<Node> nodes;  // without the nodes every sample found occluded
   uint32_t occluded = 0;    // how many those were (they are in the cut, contributing 0)
+  MergedBatch batch;        // the batched nodes again, four lanes at a time
+  // The batched nodes in groups of kGroupSize, in batch order (neighbours in the tree:
+  // lights near each other). Each group has a probe, its brightest node: a point sends it
+  // a shadow ray when the group matters, and if it is hidden there, where every sample
+  // saw it, the point tests each node of the group (a shadow thinner than the sample
+  // spacing: the blind spot of borrowed visibility).
+  static constexpr uint32_t kGroupSize = 16;  // four blocks
+  std::vector<uint32_t> batchNodes;  // per batched node: its index in `nodes`
+  std::vector<uint32_t> groupProbe;  // per group: the index in `nodes` of its probe
   void clear() {
     nodes.clear();
     occluded = 0;
+    batch.clear();
+    batchNodes.clear();
+    groupProbe.clear();
   }
 };
 
 // Walks the trees over the cuts of `count` (1..4) samples, as described above.
-void mergeCuts(const LightForest& forest, const CutRecord* const* samples, int count, MergedCut& out);
+void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecord* const* samples, int count,
+               MergedCut& out);
 
 struct ReconstructionResult {
   Color radiance;

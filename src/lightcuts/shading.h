@@ -31,6 +31,19 @@ class Visibility {
   virtual ~Visibility() = default;
   // wi: unit direction to the light; dist: distance to it (infinity for directional).
   virtual Color operator()(const Vec3& wi, float dist) = 0;
+  // As operator(), and what stopped the ray: `blocker` is kVisible when nothing opaque
+  // did, the index of a convex opaque object that did, with the distance to it in
+  // `tHit`, or kUnknownBlocker (a non-convex or unknown occluder). A convex object that
+  // blocks a set of directions blocks their convex hull too, which is what the visibility
+  // probes (evaluator.h) build on.
+  static constexpr int kVisible = -1;
+  static constexpr int kUnknownBlocker = -2;
+  virtual Color trace(const Vec3& wi, float dist, int& blocker, float& tHit) {
+    Color v = (*this)(wi, dist);
+    blocker = isBlack(v) ? kUnknownBlocker : kVisible;
+    tHit = 0;
+    return v;
+  }
 };
 
 // M * G of one light per unit intensity, without visibility. Returns false when the

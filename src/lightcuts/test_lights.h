@@ -1,7 +1,11 @@
 // Light sets, shading points and tree helpers shared by the lightcuts tests.
 #pragma once
 
+#include <cmath>
+#include <vector>
+
 #include "core/rng.h"
+#include "lightcuts/cluster.h"
 #include "lightcuts/light_tree.h"
 #include "lightcuts/shading.h"
 #include "scene/light.h"
@@ -40,6 +44,114 @@ inline ShadingPoint point(Vec3 p) {
 inline uint32_t leafCount(const LightTree& t, uint32_t i) {
   const LightNode& n = t.nodes[i];
   return n.isLeaf() ? 1u : leafCount(t, n.left) + leafCount(t, n.left + 1);
+}
+
+// ---- random clusters for the property tests (bounds, estimates) ----
+
+inline Vec3 randomUnit(Rng& r) {
+  for (;;) {
+    Vec3 v(2 * r.uniform() - 1, 2 * r.uniform() - 1, 2 * r.uniform() - 1);
+    float l2 = length2(v);
+    if (l2 > 1e-4f && l2 <= 1) return v / std::sqrt(l2);
+  }
+}
+
+// A direction within `angle` radians of `axis`.
+inline Vec3 randomInCone(Rng& r, const Vec3& axis, float angle) {
+  float cosT = 1 - r.uniform() * (1 - std::cos(angle));
+  float sinT = std::sqrt(std::max(0.0f, 1 - cosT * cosT));
+  float phi = 2 * kPi * r.uniform();
+  Vec3 u, v;
+  orthonormalBasis(axis, u, v);
+  return normalize(axis * cosT + u * (sinT * std::cos(phi)) + v * (sinT * std::sin(phi)));
+}
+
+inline LightGroup randomGroup(Rng& r, LightType type) {
+  LightGroup g;
+  switch (r.below(4)) {
+    case 0: g.atten = Attenuation{0, 0, 1, kInf}; break;
+    case 1: g.atten = Attenuation{r.uniform(), r.uniform(), r.uniform() * 0.5f, kInf}; break;
+    case 2: g.atten = Attenuation{0.25f, 0.003372407f, 0.000045492f, kInf}; break;
+    default: g.atten = Attenuation{1, 0, 0, 2 + 5 * r.uniform()}; break;
+  }
+  if (type == LightType::Directional) g.atten = Attenuation{0, 0, 0, kInf};
+  if (type == LightType::Spot) {
+    g.falloff.exponent = r.below(2) ? 0.0f : 10 * r.uniform();
+    g.falloff.cosCutoff = std::cos(kPi * (0.1f + 0.8f * r.uniform()));
+    if (r.below(2)) {
+      float outer = kPi * 0.4f * r.uniform();
+      float inner = outer * r.uniform();
+      g.falloff.cosOuter = std::cos(outer);
+      g.falloff.cosInner = std::max(std::cos(inner), g.falloff.cosOuter + 1e-6f);
+    }
+  }
+  g.diffuseOnly = r.below(4) == 0;
+  return g;
+}
+
+struct Config {
+  LightSet set;
+  LightNode node;
+  ShadingPoint sp;
+};
+
+// A random cluster of one type plus a random shading point, sometimes inside the
+// cluster's box, sometimes facing away.
+inline Config randomConfig(Rng& r, LightType type) {
+  Config c;
+  c.set.groups.push_back(randomGroup(r, type));
+  int n = 1 + int(r.below(12));
+  Vec3 centre(4 * r.uniform() - 2, 4 * r.uniform() - 2, 4 * r.uniform() - 2);
+  float spread = r.below(3) == 0 ? 0.01f : 2 * r.uniform();
+  Vec3 axis = randomUnit(r);
+  float coneAngle = r.below(3) == 0 ? 0.0f : kPi * r.uniform();
+  std::vector<detail::Cluster> cl;
+  for (int i = 0; i < n; ++i) {
+    Light l;
+    l.type = type;
+    l.group = 0;
+    l.position = centre + Vec3(r.uniform() - 0.5f, r.uniform() - 0.5f, r.uniform() - 0.5f) * spread;
+    l.direction = type == LightType::Directional ? randomInCone(r, axis, coneAngle * 0.3f)
+                                                 : randomInCone(r, axis, coneAngle);
+    l.intensity = Color(r.uniform(), r.uniform(), r.uniform()) * (0.1f + 5 * r.uniform());
+    c.set.lights.push_back(l);
+    cl.push_back(detail::leafCluster(l, uint32_t(i)));
+  }
+  detail::Cluster acc = cl[0];
+  bool withCone = type == LightType::Oriented || type == LightType::Spot;
+  for (int i = 1; i < n; ++i) acc = detail::mergeClusters(acc, cl[size_t(i)], 0, i, withCone, 7);
+  LightNode& nd = c.node;
+  nd.lo = acc.lo;
+  nd.hi = acc.hi;
+  nd.axis = acc.axis;
+  nd.cosHalfAngle = acc.cosHalfAngle;
+  nd.intensity = acc.intensity;
+  nd.rep = acc.rep;
+  nd.left = 1;
+  nd.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - acc.cosHalfAngle * acc.cosHalfAngle));
+
+  ShadingPoint& sp = c.sp;
+  sp.p = r.below(5) == 0 ? centre : Vec3(6 * r.uniform() - 3, 6 * r.uniform() - 3, 6 * r.uniform() - 3);
+  sp.n = randomUnit(r);
+  Vec3 v = randomUnit(r);
+  if (dot(v, sp.n) < 0) v = -v;
+  sp.r = normalize(reflect(v, sp.n));
+  sp.kd = Color(r.uniform(), r.uniform(), r.uniform());
+  sp.ks = r.below(3) == 0 ? Color(0) : Color(r.uniform(), r.uniform(), r.uniform());
+  const float shininess[] = {0, 0.2f, 1, 5, 25.6f, 128};
+  sp.shininess = shininess[r.below(6)];
+  return c;
+}
+
+inline Color trueSum(const Config& c) {
+  Color s(0);
+  for (const Light& l : c.set.lights) {
+    Color mg;
+    Vec3 wi;
+    float d;
+    if (lightContribution(l, c.set.groups[l.group], c.sp, mg, wi, d)) s += mg * l.intensity;
+  }
+  return s;
 }
 
 }  // namespace lc::lightcuts::test_lights

@@ -57,6 +57,26 @@ TEST(Accuracy, LightcutsWithinTwoPercentOfBruteForceOnTheCornellBox) {
   EXPECT_GT(io::compareImages(ref.image, w.image).mean_relative_error, m.mean_relative_error);
 }
 
+// With a zero threshold a lightcut refines every cluster it cannot prove hidden down to
+// its lights, so it must give brute force's image: the clusters the visibility probes
+// proved hidden behind the boxes (convex meshes) were hidden.
+TEST(Accuracy, ZeroThresholdCutsEqualBruteForceWithHiddenClusters) {
+  Loaded l = loadCornell();
+  const scene::Scene& s = *l.scene;
+  auto brute = lightcuts::makeBruteForce(s.lights());
+  lightcuts::LightForest forest = lightcuts::buildLightForest(s.lights());
+  lightcuts::CutOptions o;
+  o.errorRatio = 0;
+  o.maxCut = 1 << 20;
+  auto lc = lightcuts::makeLightcuts(s.lights(), forest, o);
+  RenderResult ref = renderWith(s, *brute, 24);
+  RenderResult test = renderWith(s, *lc, 24);
+  EXPECT_GT(test.stats.eval.hiddenClusters, 0u);
+  for (size_t i = 0; i < ref.image.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      ASSERT_NEAR(test.image.pixels[i][c], ref.image.pixels[i][c], 1e-4f * (ref.image.pixels[i][c] + 1e-3f)) << i;
+}
+
 TEST(Accuracy, ReconstructionCutsWithinTwoPercentWithFarFewerShadowRays) {
   Loaded l = loadCornell();
   const scene::Scene& s = *l.scene;

@@ -40,6 +40,22 @@ class ShadowRays final : public lightcuts::Visibility {
     if (!(tmax > 0)) return Color(1);
     return scene_.transmittance(o, wi, tmax);
   }
+  Color trace(const Vec3& wi, float dist, int& blocker, float& tHit) override {
+    Vec3 o = p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_);
+    float tmax = std::isinf(dist) ? kInf : dist - 2 * eps_;
+    blocker = kVisible;
+    tHit = 0;
+    if (!(tmax > 0)) return Color(1);
+    int shape = scene_.firstHit(o, wi, tmax, tHit);
+    if (shape < 0) return Color(1);
+    if (scene_.isTransmissive(shape)) {  // glass on the way: the walk through it decides
+      Color v = scene_.transmittance(o, wi, tmax);
+      blocker = isBlack(v) ? kUnknownBlocker : kVisible;
+      return v;
+    }
+    blocker = scene_.isConvex(shape) ? shape : kUnknownBlocker;
+    return Color(0);
+  }
 
  private:
   const Scene& scene_;

@@ -46,6 +46,18 @@ struct Attenuation {
     float den = constant + d * (linear + d * quadratic);
     return den <= 1.0f ? 1.0f : 1.0f / den;
   }
+  // d/dd of operator(): 0 where it is clamped to 1 or cut off.
+  float derivative(float d) const {
+    if (d > maxDistance) return 0.0f;
+    float den = constant + d * (linear + d * quadratic);
+    return den <= 1.0f ? 0.0f : -(linear + 2 * quadratic * d) / (den * den);
+  }
+  // Whether the clamp's corner (den = 1) lies between d0 <= d1: operator() is not smooth there.
+  bool kinkBetween(float d0, float d1) const {
+    float den0 = constant + d0 * (linear + d0 * quadratic);
+    float den1 = constant + d1 * (linear + d1 * quadratic);
+    return den0 <= 1.0f && den1 > 1.0f;
+  }
   bool operator==(const Attenuation& o) const {
     return constant == o.constant && linear == o.linear && quadratic == o.quadratic &&
            maxDistance == o.maxDistance;
