@@ -632,10 +632,11 @@ class Driver:
                  "line); Cornell box 2 s (no extra lights) / 2031 s (no lightcuts) / 95 s (lightcuts) with 8,638 VPLs, "
                  "8,638 → 273.6 VPLs per pixel. The seed's \"lights per pixel\" counted its coalesced lights, each "
                  "with a shadow ray. Ours gives two figures per shading point: the cut size (light-tree nodes whose "
-                 "light is evaluated) and the shadow rays sent. Lightcuts runs with its defaults, reconstruction "
-                 "cuts included (`--reconstruct 4`): a full lightcut every 4 pixels, and points between them "
-                 "evaluate the union of their samples' cuts, borrowing visibility where the samples agree, so "
-                 "their cut is larger than one lightcut but most of its nodes need no shadow ray.")
+                 "light is evaluated) and the shadow rays sent. Lightcuts runs with its defaults: first-order "
+                 "estimates, visibility probes and reconstruction cuts (`--reconstruct auto`, every 4 pixels at "
+                 "512×512): points between samples evaluate their samples' merged cut (the finer cut where the "
+                 "samples' visibility differs, the coarser where all saw it visible and smooth), borrowing "
+                 "visibility where the samples agree, so most of their nodes need no shadow ray.")
         L.append("")
 
         # table 2: errors
