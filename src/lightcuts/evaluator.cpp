@@ -112,8 +112,9 @@ class Lightcuts final : public LightEvaluator {
     Color unit;      // representative's M*G*V per unit intensity
     Color estimate;  // unit * cluster intensity
     float spread;    // error scale used by the total criterion (see below)
+    float lower, upper;   // luminance of the unshadowed bounds (first-order candidates)
     ShadowResult shadow;  // what the representative's shadow ray found
-    bool firstOrder;  // the estimate is the first-order one (estimate.h)
+    bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
   };
 
   static uint64_t heapKey(float bound, uint32_t index) {
@@ -235,21 +236,17 @@ class Lightcuts final : public LightEvaluator {
         // A node in the heap may be refined next: fetch its children while we work.
         __builtin_prefetch(&tree.nodes[n.left]);
         __builtin_prefetch(&tree.nodes[n.left + 1]);
-        float spread = visible ? std::max(0.0f, b - luminance(lower)) : b;
-        // The first-order estimate (estimate.h) where the contribution is smooth over the
-        // cluster and its representative unoccluded, kept within the bounds. Its spread
-        // stays upper minus lower: what it cannot see, a partly hidden cluster, is what
-        // that spread also stands for.
+        const float lo = luminance(lower);
+        float spread = visible ? std::max(0.0f, b - lo) : b;
+        // Where the contribution is smooth over the cluster and its representative is
+        // unoccluded, the node takes the first-order estimate (estimate.h) if it is still
+        // in the cut at the end (most nodes are refined before that). Its spread stays
+        // upper minus lower: what it cannot see, a partly hidden cluster, is what that
+        // spread also stands for.
         const bool fo = firstOrder && smooth && found == CutVisibility::Visible;
-        if (fo) {
-          Color u = firstOrderUnit(lights_.lights[n.rep], g, sp, tree.moments[ni], unit) * n.intensity;
-          Color corrected = vmin(vmax(u, lower), upper);
-          total += corrected - est;
-          est = corrected;
-        }
         sumSq += double(spread) * spread;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
-        nodes.push_back(CutNode{t, ni, unit, est, spread, shadow, fo});
+        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, fo});
       } else if (record) {
         record1(t, ni, found, false);
       }
@@ -260,7 +257,8 @@ class Lightcuts final : public LightEvaluator {
       if (tree.nodes.empty()) continue;
       const LightNode& root = tree.nodes[0];
       ShadowResult shadow;
-      Color unit = shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats, shadow, probes);
+      Color unit = shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats, shadow,
+                                probes && tree.moments[0].lights >= kProbeMinLights);
       addNode(t, 0, unit, shadow);
     }
     const float eps = opt_.errorRatio;
@@ -289,22 +287,36 @@ class Lightcuts final : public LightEvaluator {
       for (uint32_t c = n.left; c <= n.left + 1; ++c) {
         uint32_t rep = tree.nodes[c].rep;
         // The child that shares the parent's representative reuses its shadow ray.
+        // Only clusters that may be probed need to know what hid their representative.
         ShadowResult shadow = cn.shadow;
-        Color unit = rep == n.rep ? cn.unit : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, shadow, probes);
+        Color unit = rep == n.rep ? cn.unit
+                                  : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, shadow,
+                                                 probes && tree.moments[c].lights >= kProbeMinLights);
         addNode(cn.tree, c, unit, shadow);
       }
     }
+    // The first-order estimates of the clusters left in the cut, kept within their bounds;
+    // their ratio to the representative's is what a reconstruction borrows.
+    for (uint64_t key : heap) {
+      const CutNode& cn = nodes[uint32_t(key)];
+      float factor = 1;
+      if (cn.firstOrder) {
+        const LightTree& tree = forest_.trees[cn.tree];
+        const LightNode& n = tree.nodes[cn.node];
+        Color fo = vmax(firstOrderUnit(lights_.lights[n.rep], lights_.groups[tree.group], sp, tree.moments[cn.node],
+                                       cn.unit) * n.intensity, Color(0));
+        float raw = luminance(cn.estimate), lf = luminance(fo);
+        if (raw > 0 && lf > 0) {
+          float kept = std::clamp(lf, cn.lower, cn.upper);
+          fo *= kept / lf;
+          total += fo - cn.estimate;
+          factor = std::clamp(kept / raw, 0.5f, 2.0f);
+        }
+      }
+      if (record) record1(cn.tree, cn.node, cn.shadow.found, cn.firstOrder, factor);
+    }
     if (record) {
       // The cut: the nodes left in the heap, and the exact ones recorded as they came.
-      for (uint64_t key : heap) {
-        const CutNode& cn = nodes[uint32_t(key)];
-        float factor = 1;
-        if (cn.firstOrder) {
-          float raw = luminance(cn.unit * forest_.trees[cn.tree].nodes[cn.node].intensity);
-          factor = raw > 0 ? std::clamp(luminance(cn.estimate) / raw, 0.5f, 2.0f) : 1.0f;
-        }
-        record1(cn.tree, cn.node, cn.shadow.found, cn.firstOrder, factor);
-      }
       std::sort(recorded.begin(), recorded.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
       record->clear();
       record->valid = true;

@@ -13,7 +13,7 @@ constexpr uint8_t kAbove = 0xff;  // the sample refined this node: its cut lies 
 
 // A group of borrowed-visible nodes is checked with a probe ray when it holds more than
 // this share of the point's light.
-constexpr float kGroupShare = 0.02f;
+constexpr float kGroupShare = 0.04f;
 
 // A coarser cut is borrowed only from samples this many times closer to each other than
 // to the cluster (squared).

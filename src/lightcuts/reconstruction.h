@@ -87,10 +87,10 @@ struct MergedCut {
   MergedBatch batch;        // the batched nodes again, four lanes at a time
   // The batched nodes in groups of kGroupSize, in batch order (neighbours in the tree:
   // lights near each other). Each group has a probe, its brightest node: a point sends it
-  // a shadow ray when the group matters, and if it is hidden there, where every sample
-  // saw it, the point tests each node of the group (a shadow thinner than the sample
-  // spacing: the blind spot of borrowed visibility).
-  static constexpr uint32_t kGroupSize = 16;  // four blocks
+  // a shadow ray when the group holds over 4% of its light, and if it is hidden there,
+  // where every sample saw it, the point tests each node of the group (a shadow thinner
+  // than the sample spacing: the blind spot of borrowed visibility).
+  static constexpr uint32_t kGroupSize = 32;  // eight blocks
   std::vector<uint32_t> batchNodes;  // per batched node: its index in `nodes`
   std::vector<uint32_t> groupProbe;  // per group: the index in `nodes` of its probe
   void clear() {
