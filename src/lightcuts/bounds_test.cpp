@@ -88,12 +88,6 @@ TEST(ConeUnion, ContainsBothCones) {
   }
 }
 
-}  // namespace
-}  // namespace lc::lightcuts
-
-namespace lc::lightcuts {
-namespace {
-
 // The lower bound never exceeds the true unshadowed sum (and so brackets it with the upper).
 TEST_P(BoundProperty, LowerBoundIsAtMostTheTrueSum) {
   LightType type = GetParam();
@@ -113,12 +107,6 @@ TEST_P(BoundProperty, LowerBoundIsAtMostTheTrueSum) {
   }
   EXPECT_GT(positive, 500);  // and is not trivially zero
 }
-
-}  // namespace
-}  // namespace lc::lightcuts
-
-namespace lc::lightcuts {
-namespace {
 
 // `smooth` promises that no light of the cluster sits at a clamp of the contribution: every
 // cosine positive and the attenuation on one side of its corner, within its range.

@@ -68,6 +68,18 @@ inline Cluster mergeClusters(const Cluster& a, const Cluster& b, int32_t ia, int
   return c;
 }
 
+// A node's box, cone, intensity and representative from its cluster; no children (left = 0).
+inline void setNodeFromCluster(LightNode& n, const Cluster& c) {
+  n.lo = c.lo;
+  n.hi = c.hi;
+  n.axis = c.axis;
+  n.cosHalfAngle = c.cosHalfAngle;
+  n.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - c.cosHalfAngle * c.cosHalfAngle));
+  n.intensity = c.intensity;
+  n.rep = c.rep;
+  n.left = 0;
+}
+
 // Lays the cluster tree under `root` out as LightNodes: root first, siblings adjacent.
 inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, LightTree& tree) {
   tree.nodes.clear();
@@ -78,15 +90,7 @@ inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, Light
     auto [ci, ni] = stack.back();
     stack.pop_back();
     const Cluster& c = clusters[size_t(ci)];
-    LightNode& n = tree.nodes[ni];
-    n.lo = c.lo;
-    n.hi = c.hi;
-    n.axis = c.axis;
-    n.cosHalfAngle = c.cosHalfAngle;
-    n.intensity = c.intensity;
-    n.rep = c.rep;
-    n.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - c.cosHalfAngle * c.cosHalfAngle));
-    n.left = 0;
+    setNodeFromCluster(tree.nodes[ni], c);
     if (c.left >= 0) {
       uint32_t j = uint32_t(tree.nodes.size());
       tree.nodes[ni].left = j;

@@ -120,15 +120,8 @@ inline Config randomConfig(Rng& r, LightType type) {
   detail::Cluster acc = cl[0];
   bool withCone = type == LightType::Oriented || type == LightType::Spot;
   for (int i = 1; i < n; ++i) acc = detail::mergeClusters(acc, cl[size_t(i)], 0, i, withCone, 7);
-  LightNode& nd = c.node;
-  nd.lo = acc.lo;
-  nd.hi = acc.hi;
-  nd.axis = acc.axis;
-  nd.cosHalfAngle = acc.cosHalfAngle;
-  nd.intensity = acc.intensity;
-  nd.rep = acc.rep;
-  nd.left = 1;
-  nd.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - acc.cosHalfAngle * acc.cosHalfAngle));
+  detail::setNodeFromCluster(c.node, acc);
+  c.node.left = 1;  // an inner node, as a cluster of several lights is in a tree
 
   ShadingPoint& sp = c.sp;
   sp.p = r.below(5) == 0 ? centre : Vec3(6 * r.uniform() - 3, 6 * r.uniform() - 3, 6 * r.uniform() - 3);
