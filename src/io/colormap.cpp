@@ -33,11 +33,6 @@ int lineCount(const std::string& s) { return 1 + int(std::count(s.begin(), s.end
 
 int legendScale(int width) { return std::clamp(width / kHeatmapMinWidth, 1, 3); }
 
-std::string tickLabel(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", v + 0.0);  // + 0.0 turns -0 into 0
-  return buf;
-}
 
 void fillRect(Image& img, int x0, int y0, int x1, int y1, Color c) {
   x0 = std::max(x0, 0);
@@ -145,6 +140,17 @@ void drawText(Image& img, int x, int y, const std::string& text, Color color, in
   }
 }
 
+std::string heatmapTickLabel(double v) {
+  char buf[32];
+  // Whole numbers up to seven digits as they are: "25980", not "2.598e+04", which runs
+  // into its neighbours on a 256-pixel bar.
+  if (std::abs(v) >= 1e4 && std::abs(v) < 1e7)
+    std::snprintf(buf, sizeof buf, "%.0f", v);
+  else
+    std::snprintf(buf, sizeof buf, "%.4g", v + 0.0);  // + 0.0 turns -0 into 0
+  return buf;
+}
+
 int heatmapLegendHeight(int width, const std::string& title) { return legendLayout(width, title).height; }
 
 Image heatmap(const std::vector<float>& values, int w, int h, float vmin, float vmax,
@@ -175,7 +181,7 @@ Image heatmap(const std::vector<float>& values, int w, int h, float vmin, float 
   for (int k = 0; k < nTicks; ++k) {
     double t = nTicks == 1 ? 0.0 : double(k) / (nTicks - 1);
     tickT.push_back(t);
-    labels.push_back(tickLabel(sc.degenerate ? double(vmin) : sc.valueAt(t)));
+    labels.push_back(heatmapTickLabel(sc.degenerate ? double(vmin) : sc.valueAt(t)));
     maxLabelW = std::max(maxLabelW, textWidth(labels.back(), s));
   }
   const int margin = std::max(L.pad, maxLabelW / 2 + s);

@@ -34,6 +34,9 @@ constexpr int kHeatmapMinWidth = 240;
 Image heatmap(const std::vector<float>& values, int w, int h, float vmin, float vmax,
               const std::string& title, bool logScale = false);
 
+// A legend's tick label: %.4g, but whole numbers from 10,000 to 9,999,999 in full.
+std::string heatmapTickLabel(double v);
+
 // Height of the legend strip heatmap() appends for an output `width` pixels wide.
 int heatmapLegendHeight(int width, const std::string& title);
 

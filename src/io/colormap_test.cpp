@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -105,6 +106,23 @@ TEST(Colormap, LegendHasTitleBarAndLabels) {
   while (img.at(last, barRow) == kHeatmapBackground) --last;
   EXPECT_EQ(img.at(first, barRow), viridis(0));
   EXPECT_EQ(img.at(last, barRow), viridis(1));
+}
+
+// The labels of a large cut-size range (0 .. 25,980) do not run into each other on the
+// narrowest legend.
+TEST(Colormap, TickLabelsOfLargeValuesStayShort) {
+  EXPECT_EQ(heatmapTickLabel(25980.4), "25980");
+  EXPECT_EQ(heatmapTickLabel(12990), "12990");
+  EXPECT_EQ(heatmapTickLabel(0.0125), "0.0125");
+  EXPECT_EQ(heatmapTickLabel(456.5), "456.5");
+  EXPECT_EQ(heatmapTickLabel(-0.0), "0");
+  EXPECT_EQ(heatmapTickLabel(2.5e8), "2.5e+08");
+  // heatmap() spaces five ticks over the bar, whose margins are half the widest label:
+  // each label must be narrower than the space between ticks, with a gap.
+  int widest = 0;
+  for (int k = 0; k < 5; ++k) widest = std::max(widest, textWidth(heatmapTickLabel(25980.0 * k / 4)));
+  const int spacing = (kHeatmapMinWidth - 2 * (widest / 2 + 1)) / 4;
+  EXPECT_LE(widest + 6, spacing) << "widest label " << widest << " px, ticks " << spacing << " px apart";
 }
 
 TEST(Colormap, DrawText) {
