@@ -7,6 +7,7 @@
 #   ./scripts/bench.sh --resume                 # extra arguments go to bench.py (see --help)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-pkgs=(python3 python3-numpy python3-matplotlib python3-pil imagemagick)
+# libmagickcore-6.q16-6-extra: ImageMagick's OpenEXR delegate (convert reads the .exr renders).
+pkgs=(python3 python3-numpy python3-matplotlib python3-pil imagemagick libmagickcore-6.q16-6-extra)
 scripts/install-deps.sh "${pkgs[@]}"
 exec /usr/bin/python3 scripts/bench.py --build "${BUILD:-build}" "$@"
