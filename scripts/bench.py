@@ -883,7 +883,18 @@ class Driver:
 
     # --- main --------------------------------------------------------------------------------
 
+    def check_exr_reader(self):
+        """Fails before measuring, not an hour later, when ImageMagick cannot read the renders."""
+        try:
+            formats = subprocess.run(["convert", "-list", "format"], capture_output=True, text=True).stdout
+        except OSError:
+            formats = ""
+        if not re.search(r"^\s*EXR\*?\s+EXR\s+r", formats, re.M):
+            raise SystemExit("bench: ImageMagick's convert cannot read OpenEXR; install imagemagick and "
+                             "libmagickcore-6.q16-6-extra (scripts/bench.sh does)")
+
     def main(self):
+        self.check_exr_reader()
         if not self.a.write_only:
             if not os.path.exists(self.lc):
                 raise SystemExit(f"bench: {self.rel(self.lc)} not found: build first (make build BUILD=...)")
