@@ -85,6 +85,22 @@ TexScalar resolveScalar(const io::ScalarParam& p, TextureCache& cache, const Bui
   return s;
 }
 
+// A closest-hit query from o along d over [tnear, tfar], no hit yet.
+RTCRayHit rayHit(const Vec3& o, const Vec3& d, float tnear, float tfar) {
+  RTCRayHit rh;
+  rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
+  rh.ray.dir_x = d.x; rh.ray.dir_y = d.y; rh.ray.dir_z = d.z;
+  rh.ray.tnear = tnear;
+  rh.ray.tfar = tfar;
+  rh.ray.time = 0;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.id = 0;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+
 }  // namespace
 
 Scene::~Scene() {
@@ -306,17 +322,7 @@ size_t Scene::triangleCount() const {
 bool Scene::intersect(const Ray& ray, Hit& hit) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  RTCRayHit rh;
-  rh.ray.org_x = ray.o.x; rh.ray.org_y = ray.o.y; rh.ray.org_z = ray.o.z;
-  rh.ray.dir_x = ray.d.x; rh.ray.dir_y = ray.d.y; rh.ray.dir_z = ray.d.z;
-  rh.ray.tnear = ray.tmin;
-  rh.ray.tfar = ray.tmax;
-  rh.ray.time = 0;
-  rh.ray.mask = 0xFFFFFFFFu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  RTCRayHit rh = rayHit(ray.o, ray.d, ray.tmin, ray.tmax);
   rtcIntersect1(rtc_, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
@@ -382,17 +388,7 @@ bool Scene::occluded(const Vec3& origin, const Vec3& dir, float tmax) const {
 int Scene::firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  RTCRayHit rh;
-  rh.ray.org_x = origin.x; rh.ray.org_y = origin.y; rh.ray.org_z = origin.z;
-  rh.ray.dir_x = dir.x; rh.ray.dir_y = dir.y; rh.ray.dir_z = dir.z;
-  rh.ray.tnear = 0;
-  rh.ray.tfar = tmax;
-  rh.ray.time = 0;
-  rh.ray.mask = 0xFFFFFFFFu;
-  rh.ray.id = 0;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  RTCRayHit rh = rayHit(origin, dir, 0, tmax);
   rtcIntersect1(rtc_, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
   t = rh.ray.tfar;
