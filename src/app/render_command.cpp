@@ -55,6 +55,7 @@ struct RenderArgs {
 // and 0.25 gives the default Cornell box about the cut the seed reported (257 vs 273.6
 // lights per pixel).
 constexpr float kLightcutsDefaultError = 0.02f;
+constexpr float kSeedDefaultError = 0.25f;
 
 // --reconstruct auto: reconstruction cuts (every 4 pixels) from 512 x 512 pixels up, a
 // full lightcut at every point below. A cell of 4 x 4 pixels covers four times the
@@ -66,7 +67,6 @@ int reconstructSpacing(const std::string& option, int width, int height) {
   if (option != "auto") return std::stoi(option);
   return int64_t(width) * height >= 512 * 512 ? 4 : 0;
 }
-constexpr float kSeedDefaultError = 0.25f;
 
 std::string defaultOutput(const std::string& scene) {
   std::string stem = scene;

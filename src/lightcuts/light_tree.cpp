@@ -136,8 +136,8 @@ void computeSeedData(const LightSet& lights, LightTree& tree) {
       continue;
     }
     const SeedNodeData& da = sd[n.left];
-    d.direction = length2(mo.meanAxis) > 0 ? normalize(mo.meanAxis) : da.direction;
     const SeedNodeData& db = sd[n.left + 1];
+    d.direction = length2(mo.meanAxis) > 0 ? normalize(mo.meanAxis) : da.direction;
     float wa = luminance(tree.nodes[n.left].intensity), wb = luminance(tree.nodes[n.left + 1].intensity);
     float w = wa + wb;
     if (!(w > 0)) { wa = wb = 0.5f; w = 1; }

@@ -114,7 +114,6 @@ void computePreorder(LightTree& tree);
 // Fills LightTree::moments from the finished nodes (buildLightForest calls it).
 void computeMoments(const LightSet& lights, LightTree& tree);
 
-
 // Fills LightTree::seed from the finished nodes and their moments (centroids, mean
 // directions, errors).
 void computeSeedData(const LightSet& lights, LightTree& tree);

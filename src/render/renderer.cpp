@@ -35,14 +35,14 @@ class ShadowRays final : public lightcuts::Visibility {
  public:
   ShadowRays(const Scene& s, const Hit& h) : scene_(s), p_(h.p), ng_(h.ng), eps_(s.epsilon()) {}
   Color operator()(const Vec3& wi, float dist) override {
-    Vec3 o = p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_);
-    float tmax = std::isinf(dist) ? kInf : dist - 2 * eps_;
+    float tmax;
+    Vec3 o = origin(wi, dist, tmax);
     if (!(tmax > 0)) return Color(1);
     return scene_.transmittance(o, wi, tmax);
   }
   Color trace(const Vec3& wi, float dist, int& blocker, float& tHit) override {
-    Vec3 o = p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_);
-    float tmax = std::isinf(dist) ? kInf : dist - 2 * eps_;
+    float tmax;
+    Vec3 o = origin(wi, dist, tmax);
     blocker = kVisible;
     tHit = 0;
     if (!(tmax > 0)) return Color(1);
@@ -58,6 +58,13 @@ class ShadowRays final : public lightcuts::Visibility {
   }
 
  private:
+  // The ray's origin, off the surface on the light's side, and its length to just short
+  // of the light.
+  Vec3 origin(const Vec3& wi, float dist, float& tmax) const {
+    tmax = std::isinf(dist) ? kInf : dist - 2 * eps_;
+    return p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_);
+  }
+
   const Scene& scene_;
   Vec3 p_, ng_;
   float eps_;
