@@ -81,6 +81,22 @@ constexpr Vec3 lerp(float t, const Vec3& a, const Vec3& b) { return a * (1 - t) 
 // Reflect v about n (both pointing away from the surface): r = 2(n.v)n - v.
 constexpr Vec3 reflect(const Vec3& v, const Vec3& n) { return n * (2 * dot(n, v)) - v; }
 
+// x^e for x >= 0: by repeated squaring when e is a whole number up to 1024 (Phong
+// exponents mostly are; a few multiplies instead of std::pow's exp/log), else std::pow.
+// Monotone in x like std::pow (each rounded product is), so the light bounds that call it
+// stay above the contributions that call it.
+inline float powNonNegative(float x, float e) {
+  if (e >= 0 && e <= 1024 && e == float(int(e))) {
+    float r = 1, b = x;
+    for (int k = int(e); k != 0; k >>= 1) {
+      if (k & 1) r *= b;
+      b *= b;
+    }
+    return r;
+  }
+  return std::pow(x, e);
+}
+
 // An orthonormal basis with w = n (Duff et al. 2017, "Building an orthonormal basis, revisited").
 inline void orthonormalBasis(const Vec3& n, Vec3& u, Vec3& v) {
   float sign = std::copysign(1.0f, n.z);

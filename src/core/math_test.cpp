@@ -79,4 +79,18 @@ TEST(Rng, UniformIsInUnitInterval) {
   EXPECT_NEAR(sum / 100000, 0.5, 0.01);
 }
 
+TEST(PowNonNegative, MatchesStdPowAndIsMonotone) {
+  for (float e : {0.0f, 1.0f, 2.0f, 7.0f, 20.0f, 60.0f, 128.0f, 2.5f, 0.3f}) {
+    float prev = -1;
+    for (int i = 0; i <= 1000; ++i) {
+      float x = float(i) / 1000;
+      float p = powNonNegative(x, e), q = std::pow(x, e);
+      EXPECT_NEAR(p, q, 2e-5f * std::max(q, 1e-30f) + 1e-37f) << "x=" << x << " e=" << e;
+      EXPECT_GE(p, prev) << "not monotone at x=" << x << " e=" << e;
+      prev = p;
+    }
+  }
+  EXPECT_EQ(powNonNegative(0.0f, 0.0f), 1.0f);  // as std::pow: a shininess of 0 is a constant 1
+}
+
 }  // namespace lc

@@ -138,9 +138,9 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
   bool sm = lower && cNLo > 0 && (type == LightType::Omni || type == LightType::Oriented);
   if (specular) {
     RotatedBox br(fr.r, c, h);
-    mUp += sp.ks * std::pow(std::min(1.0f, br.cosUpper() + kSlack), sp.shininess);
+    mUp += sp.ks * powNonNegative(std::min(1.0f, br.cosUpper() + kSlack), sp.shininess);
     float cRLo = cNLo > 0 ? std::max(0.0f, (br.cz - br.hz) / dMax) : 0.0f;
-    if (cNLo > 0) mLo += sp.ks * std::pow(cRLo, sp.shininess);
+    if (cNLo > 0) mLo += sp.ks * powNonNegative(cRLo, sp.shininess);
     sm = sm && cRLo > 0;
   }
   float gUp = 1, gLo = 1;
@@ -154,9 +154,14 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
       // by the projection's range and [dMin, dMax]; then widened/narrowed by the cone.
       float pc = -dot(c, node.axis), ph = dot(vabs(node.axis), h);
       float up = pc + ph;
-      float cosUp = up <= 0 ? 0.0f : (dMin > 0 ? std::min(1.0f, up / dMin) : 1.0f);
+      // A negative projection is a cosine below 0 for every light, at most up / dMax (the
+      // longest vector brings it nearest 0). It is kept, not clamped to 0: widened by the
+      // cone it stays below 0 when every light faces away from the point (the far side of
+      // a luminous sphere), where 0 would widen to sin(beta) and keep those lights.
+      float cosUp = up <= 0 ? (dMax > 0 ? std::max(-1.0f, up / dMax) : 0.0f)
+                            : (dMin > 0 ? std::min(1.0f, up / dMin) : 1.0f);
       // The slack only rounds a positive bound up: a zero bound is exact (nothing reaches).
-      float cUp = coneWiden(cosUp, node.cosHalfAngle, node.sinHalfAngle);
+      float cUp = std::max(0.0f, coneWiden(cosUp, node.cosHalfAngle, node.sinHalfAngle));
       if (cUp > 0) cUp = std::min(1.0f, cUp + kSlack);
       gUp *= type == LightType::Oriented ? cUp : g.falloff(cUp);
       if (lower) {

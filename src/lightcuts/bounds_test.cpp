@@ -88,6 +88,35 @@ TEST(ConeUnion, ContainsBothCones) {
   }
 }
 
+// A cluster of oriented lights that all face away from the point, by more than the cone's
+// half-angle, reaches it with nothing: the bound is exactly 0, however far past 90 degrees
+// they face (a cosine below 0 is kept through the cone widening, not clamped to 0 first,
+// which left sin(half-angle) for the far side of every luminous sphere).
+TEST(ClusterBound, LightsFacingAwayGiveZero) {
+  for (float away : {1.8f, 2.2f, 3.0f}) {  // angle between the cone's axis and the point, radians
+    LightNode node;
+    node.lo = Vec3(-0.05f, -0.05f, -0.05f);
+    node.hi = Vec3(0.05f, 0.05f, 0.05f);
+    node.axis = Vec3(std::sin(away), 0, std::cos(away));  // the point is along +z
+    node.cosHalfAngle = std::cos(0.1f);
+    node.sinHalfAngle = std::sin(0.1f);
+    node.intensity = Color(1);
+    ShadingPoint sp;
+    sp.p = Vec3(0, 0, 5);
+    sp.n = Vec3(0, 0, -1);  // facing the cluster
+    sp.r = sp.n;
+    sp.kd = Color(1);
+    LightGroup g;
+    BoundFrames fr(sp);
+    EXPECT_EQ(luminance(clusterBound(node, LightType::Oriented, g, sp, fr)), 0.0f) << "away " << away;
+    // Turned toward the point within the half-angle, it is lit again.
+    node.axis = Vec3(std::sin(away - 1.5f), 0, std::cos(away - 1.5f));
+    if (away - 1.5f < 1.4f) {
+      EXPECT_GT(luminance(clusterBound(node, LightType::Oriented, g, sp, fr)), 0.0f) << "away " << away;
+    }
+  }
+}
+
 // The lower bound never exceeds the true unshadowed sum (and so brackets it with the upper).
 TEST_P(BoundProperty, LowerBoundIsAtMostTheTrueSum) {
   LightType type = GetParam();

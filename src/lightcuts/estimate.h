@@ -65,7 +65,7 @@ inline Color firstOrderUnit(const Light& rep, const LightGroup& g, const Shading
     float cR = std::max(0.0f, dot(sp.r, w));
     float dR = (dot(sp.r, dx) - cR * wdx) * invR;
     // Shininess 0: a constant factor 1 (as lightContribution() has it), no derivative.
-    float p1 = sp.shininess > 0 && cR > 0 ? std::pow(cR, sp.shininess - 1) : 0.0f;
+    float p1 = sp.shininess > 0 && cR > 0 ? powNonNegative(cR, sp.shininess - 1) : 0.0f;
     mat += sp.ks * (sp.shininess > 0 ? p1 * cR : 1.0f);
     dMat += sp.ks * (sp.shininess * p1 * dR);
   }

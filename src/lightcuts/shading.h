@@ -73,7 +73,7 @@ inline bool lightContribution(const Light& l, const LightGroup& g, const Shading
   Color m = sp.kd * cosN;
   if (!g.diffuseOnly && sp.hasSpecular()) {
     float cosR = std::max(0.0f, dot(sp.r, wi));
-    if (cosR > 0 || sp.shininess == 0) m += sp.ks * std::pow(cosR, sp.shininess);
+    if (cosR > 0 || sp.shininess == 0) m += sp.ks * powNonNegative(cosR, sp.shininess);
   }
   mg = m * G;
   return !isBlack(mg);

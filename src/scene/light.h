@@ -75,7 +75,7 @@ struct SpotFalloff {
 
   float operator()(float c) const {
     if (c <= cosCutoff) return 0.0f;
-    float f = exponent == 0 ? 1.0f : std::pow(std::max(c, 0.0f), exponent);
+    float f = exponent == 0 ? 1.0f : powNonNegative(std::max(c, 0.0f), exponent);
     if (cosOuter > -2) {
       if (c <= cosOuter) return 0.0f;
       if (c < cosInner) {
