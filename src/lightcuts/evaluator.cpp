@@ -46,12 +46,25 @@ const char* estimatorName(Estimator e) {
 namespace {
 
 // The total criterion bounds the root-sum-square of the cut's error spreads by this factor
-// times errorRatio (spread: upper minus lower bound for a cluster whose representative is
-// visible, the upper bound otherwise). The errors have random signs and sit well inside
-// their spreads; with 1.75, at --error 0.02 over 99% of pixels come within 2% of brute
-// force on the Cornell box, the church and the Roman hall (2 fails the church, whose
-// emitters are mostly hidden; docs/LIGHTCUTS.md has the figures).
-constexpr double kTotalFactor = 1.75;
+// times errorRatio. A node's spread is its upper bound, or, when its representative is
+// visible and so was its sibling's, upper minus lower bound (what the estimate of an
+// unoccluded cluster can be off by); for a first-order estimate (estimate.h) that is
+// scaled by the point's boundary rate (below). The errors have random signs and sit inside their
+// spreads; with 1.6, at --error 0.02 over 99% of pixels come within 2% of brute force on
+// every scene of the benchmark (the church, whose emitters are mostly hidden, is the
+// hardest; docs/LIGHTCUTS.md has the figures).
+constexpr double kTotalFactor = 1.6;
+
+// Where a point sees few shadow boundaries, a first-order estimate of a cluster whose
+// representative is visible errs by a small part of its upper minus lower bound (its
+// error is second order; measured on the Cornell box and the emitter, a median of
+// 0.12-0.2 of it), but where many clusters are split by shadows (the church) a visible
+// representative often belongs to a partly hidden cluster, and the error can exceed that
+// spread. So the spread of such a node is scaled by kSmoothSpreadPerBoundary times the
+// point's boundary rate (the share of its refined clusters whose two children's
+// representatives disagreed about visibility), kept within [kSmoothSpreadMin, 1].
+constexpr double kSmoothSpreadPerBoundary = 7.0;
+constexpr double kSmoothSpreadMin = 0.5;
 
 // Clusters of fewer lights are refined rather than probed: up to eight corner rays cost
 // more than refining a small cluster does.
@@ -115,6 +128,7 @@ class Lightcuts final : public LightEvaluator {
     float lower, upper;   // luminance of the unshadowed bounds (first-order candidates)
     ShadowResult shadow;  // what the representative's shadow ray found
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
+    bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
   };
 
   static uint64_t heapKey(float bound, uint32_t index) {
@@ -201,7 +215,10 @@ class Lightcuts final : public LightEvaluator {
     BoundFrames frames(sp);
     Color total(0);
     uint32_t cutSize = 0;
-    double sumSq = 0;  // sum of the squared spreads of the nodes in the heap
+    // Sums of the squared spreads of the nodes in the heap: those scaled by the boundary
+    // rate, and the others.
+    double sumSq = 0, sumScaled = 0;
+    uint32_t refinedTested = 0, refinedSplit = 0;  // the boundary rate's counts
     const bool rss = opt_.criterion == CutCriterion::Total;
     const bool firstOrder = opt_.estimator == Estimator::FirstOrder;
     const bool probes = opt_.visibilityProbes;
@@ -210,7 +227,8 @@ class Lightcuts final : public LightEvaluator {
     auto record1 = [&](uint32_t t, uint32_t ni, CutVisibility found, bool fo, float factor = 1) {
       recorded.emplace_back(uint64_t(t) << 32 | CutRecord::pack(forest_.trees[t].preorder[ni], found, fo), factor);
     };
-    auto addNode = [&](uint32_t t, uint32_t ni, const Color& unit, const ShadowResult& shadow) {
+    auto addNode = [&](uint32_t t, uint32_t ni, const Color& unit, const ShadowResult& shadow,
+                       bool boundary = false) {
       const CutVisibility found = shadow.found;
       const LightTree& tree = forest_.trees[t];
       const LightNode& n = tree.nodes[ni];
@@ -224,9 +242,10 @@ class Lightcuts final : public LightEvaluator {
       ++stats.boundsEvaluated;
       const LightGroup& g = lights_.groups[tree.group];
       // The total criterion adds up how far each estimate may be off: a cluster whose
-      // representative is visible is assumed unoccluded, so its estimate is within the
-      // upper minus the lower bound of its unshadowed light; otherwise (or when it is
-      // partly hidden, which the per-node rule still bounds) within the upper bound.
+      // representative is visible (and whose sibling's was: not on a shadow boundary,
+      // `boundary`) is assumed unoccluded, so its estimate is within the upper minus the
+      // lower bound of its unshadowed light; otherwise (or when it is partly hidden, which
+      // the per-node rule still bounds) within the upper bound.
       bool visible = (rss || firstOrder) && !isBlack(unit);
       Color lower;
       bool smooth = false;
@@ -237,16 +256,17 @@ class Lightcuts final : public LightEvaluator {
         __builtin_prefetch(&tree.nodes[n.left]);
         __builtin_prefetch(&tree.nodes[n.left + 1]);
         const float lo = luminance(lower);
-        float spread = visible ? std::max(0.0f, b - lo) : b;
+        float spread = visible && !boundary ? std::max(0.0f, b - lo) : b;
         // Where the contribution is smooth over the cluster and its representative is
         // unoccluded, the node takes the first-order estimate (estimate.h) if it is still
         // in the cut at the end (most nodes are refined before that). Its spread stays
         // upper minus lower: what it cannot see, a partly hidden cluster, is what that
         // spread also stands for.
         const bool fo = firstOrder && smooth && found == CutVisibility::Visible;
-        sumSq += double(spread) * spread;
+        const bool scaled = rss && fo && !boundary;
+        (scaled ? sumScaled : sumSq) += double(spread) * spread;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
-        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, fo});
+        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, fo, scaled});
       } else if (record) {
         record1(t, ni, found, false);
       }
@@ -267,10 +287,16 @@ class Lightcuts final : public LightEvaluator {
       if (cutSize >= uint32_t(opt_.maxCut)) break;
       float limit = eps * luminance(total);
       const uint64_t top = heap.front();
-      if (keyBound(top) <= limit && (!rss || sumSq <= rssFactor2 * double(limit) * limit)) break;
+      if (keyBound(top) <= limit) {
+        if (!rss) break;
+        const double w = std::clamp(kSmoothSpreadPerBoundary * refinedSplit / std::max(1u, refinedTested),
+                                    kSmoothSpreadMin, 1.0);
+        if (sumSq + w * w * sumScaled <= rssFactor2 * double(limit) * limit) break;
+      }
       heapPop(heap);
       const CutNode cn = nodes[uint32_t(top)];
-      sumSq = std::max(0.0, sumSq - double(cn.spread) * cn.spread);
+      double& sum = cn.scaled ? sumScaled : sumSq;
+      sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
       const LightTree& tree = forest_.trees[cn.tree];
       const LightGroup& g = lights_.groups[tree.group];
       if (probes && cn.shadow.blocker >= 0 && tree.moments[cn.node].lights >= kProbeMinLights &&
@@ -284,16 +310,26 @@ class Lightcuts final : public LightEvaluator {
       total -= cn.estimate;
       --cutSize;
       const LightNode& n = tree.nodes[cn.node];
-      for (uint32_t c = n.left; c <= n.left + 1; ++c) {
-        uint32_t rep = tree.nodes[c].rep;
+      ShadowResult shadows[2];
+      Color units[2];
+      for (uint32_t k = 0; k < 2; ++k) {
+        const uint32_t c = n.left + k, rep = tree.nodes[c].rep;
         // The child that shares the parent's representative reuses its shadow ray.
         // Only clusters that may be probed need to know what hid their representative.
-        ShadowResult shadow = cn.shadow;
-        Color unit = rep == n.rep ? cn.unit
-                                  : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, shadow,
-                                                 probes && tree.moments[c].lights >= kProbeMinLights);
-        addNode(cn.tree, c, unit, shadow);
+        shadows[k] = cn.shadow;
+        units[k] = rep == n.rep ? cn.unit
+                                : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, shadows[k],
+                                               probes && tree.moments[c].lights >= kProbeMinLights);
       }
+      // A shadow boundary: one child's representative is hidden, the other's not.
+      bool boundary = false;
+      if (shadows[0].found != CutVisibility::Untested && shadows[1].found != CutVisibility::Untested) {
+        auto hidden = [](CutVisibility v) { return v == CutVisibility::Occluded || v == CutVisibility::Partial; };
+        boundary = hidden(shadows[0].found) != hidden(shadows[1].found);
+        ++refinedTested;
+        refinedSplit += boundary;
+      }
+      for (uint32_t k = 0; k < 2; ++k) addNode(cn.tree, n.left + k, units[k], shadows[k], boundary);
     }
     // The first-order estimates of the clusters left in the cut, kept within their bounds;
     // their ratio to the representative's is what a reconstruction borrows.

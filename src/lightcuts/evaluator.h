@@ -37,10 +37,12 @@ const char* methodName(Method m);
 //     et al. 2005). The errors of many nodes near the threshold add up, so the total
 //     error is often a few times errorRatio.
 //   Total: the same, and also the root-sum-square of the nodes' error spreads is below
-//     1.75 x errorRatio times the estimate. A node's spread is its upper bound, or, when
-//     its representative is visible, its upper minus its lower bound (what the estimate
-//     of an unoccluded cluster can be off by). The errors of a cut have random signs, so
-//     this keeps the total error, not just each node's, near errorRatio.
+//     1.6 x errorRatio times the estimate. A node's spread is its upper bound, or, when
+//     its representative is visible and its sibling's was not hidden, its upper minus its
+//     lower bound (what the estimate of an unoccluded cluster can be off by), for a
+//     first-order estimate scaled down where the point sees few shadow boundaries
+//     (evaluator.cpp). The errors of a cut have random signs, so this keeps the total
+//     error, not just each node's, near errorRatio.
 enum class CutCriterion { Walter, Total };
 CutCriterion parseCutCriterion(const std::string& name);  // "walter" | "total"
 const char* cutCriterionName(CutCriterion c);
