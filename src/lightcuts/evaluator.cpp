@@ -47,12 +47,12 @@ namespace {
 
 // The total criterion bounds the root-sum-square of the cut's error spreads by this factor
 // times errorRatio. A node's spread is its upper bound, or, when its representative is
-// visible and so was its sibling's, upper minus lower bound (what the estimate of an
-// unoccluded cluster can be off by); for a first-order estimate (estimate.h) that is
-// scaled by the point's boundary rate (below). The errors have random signs and sit inside their
-// spreads; with 1.6, at --error 0.02 over 99% of pixels come within 2% of brute force on
-// every scene of the benchmark (the church, whose emitters are mostly hidden, is the
-// hardest; docs/LIGHTCUTS.md has the figures).
+// visible and its sibling's was not hidden, upper minus lower bound (what the estimate of
+// an unoccluded cluster can be off by); for a first-order estimate (estimate.h) that is
+// scaled by the point's boundary rate (below). The errors have random signs and sit
+// inside their spreads; with 1.6, at --error 0.02 over 99% of pixels come within 2% of
+// brute force on every scene of the benchmark (the church, whose emitters are mostly
+// hidden, is the hardest; docs/LIGHTCUTS.md has the figures).
 constexpr double kTotalFactor = 1.6;
 
 // Where a point sees few shadow boundaries, a first-order estimate of a cluster whose
@@ -259,9 +259,9 @@ class Lightcuts final : public LightEvaluator {
         float spread = visible && !boundary ? std::max(0.0f, b - lo) : b;
         // Where the contribution is smooth over the cluster and its representative is
         // unoccluded, the node takes the first-order estimate (estimate.h) if it is still
-        // in the cut at the end (most nodes are refined before that). Its spread stays
-        // upper minus lower: what it cannot see, a partly hidden cluster, is what that
-        // spread also stands for.
+        // in the cut at the end (most nodes are refined before that). Its spread, upper
+        // minus lower, is scaled by the boundary rate when the criterion is tested: the
+        // estimate's own error is second order, a partly hidden cluster's is not.
         const bool fo = firstOrder && smooth && found == CutVisibility::Visible;
         const bool scaled = rss && fo && !boundary;
         (scaled ? sumScaled : sumSq) += double(spread) * spread;
