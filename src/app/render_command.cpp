@@ -318,7 +318,7 @@ void addRenderCommand(CLI::App& app) {
       ->check(CLI::Range(0.0, 1e6));
   c->add_option("--max-cut", a->maxCut, "Most nodes in one cut (default 4000)")->check(CLI::Range(1, 1 << 30));
   c->add_option("--cut-criterion", a->criterion,
-                "When a lightcut stops: total (every bound and their root-sum-square below error x estimate, default) "
+                "When a lightcut stops: total (every bound below error x estimate and the root-sum-square of the error spreads below 1.6 x that, default) "
                 "or walter (every bound below error x estimate, as published)")
       ->check(CLI::IsMember({"total", "walter"}));
   c->add_option("--estimator", a->estimator,
