@@ -291,8 +291,8 @@ void storePixel(RenderResult& res, int width, int x, int y, const PixelResult& p
 // tile to need one computes it, the other reads it. A tile that finds one being computed
 // computes its own copy (the same values: a sample depends only on its pixel), so no
 // thread waits on another. The shared samples are kept until the render ends: at 2048 x
-// 2048 the green emitter peaks at 235 MB instead of 166 MB (and renders in 53 s instead of
-// 89 s); freeing each once all its tiles are done would bound that.
+// 2048 the green emitter peaks at 235 MB (166 MB before this and the criterion's
+// recalibration); freeing each once all its tiles are done would bound that.
 class EdgeSamples {
  public:
   EdgeSamples(int width, int height, int tile)
