@@ -33,7 +33,6 @@ int lineCount(const std::string& s) { return 1 + int(std::count(s.begin(), s.end
 
 int legendScale(int width) { return std::clamp(width / kHeatmapMinWidth, 1, 3); }
 
-
 void fillRect(Image& img, int x0, int y0, int x1, int y1, Color c) {
   x0 = std::max(x0, 0);
   y0 = std::max(y0, 0);

@@ -309,7 +309,8 @@ class EdgeSamples {
 
   // The entry of pixel (x, y) if it lies on a line between tiles, else null.
   Entry* at(int x, int y) {
-    if (x > 0 && x % tile_ == 0 && x / tile_ <= linesX_) return &entries_[size_t(x / tile_ - 1) * size_t(height_) + size_t(y)];
+    if (x > 0 && x % tile_ == 0 && x / tile_ <= linesX_)
+      return &entries_[size_t(x / tile_ - 1) * size_t(height_) + size_t(y)];
     if (y > 0 && y % tile_ == 0 && y / tile_ <= linesY_)
       return &entries_[size_t(linesX_) * size_t(height_) + size_t(y / tile_ - 1) * size_t(width_) + size_t(x)];
     return nullptr;
@@ -337,22 +338,21 @@ struct ReconstructionTile {
   EvalStats& stats;
   uint64_t &primary, &secondary, &samples, &fallbacks;
   std::vector<CutSample>& slots;
-  std::vector<uint8_t>& state;  // per slot: kSampled and kDone bits
-  std::vector<const CutSample*>& shared;  // per sampled slot: its sample (the slot's, or an EdgeSamples one)
+  std::vector<uint8_t>& state;  // per slot: kDone when its pixel is stored
+  std::vector<const CutSample*>& shared;  // per slot: its sample (the slot's, or an EdgeSamples one), once made
   CellCuts& cell;
   RenderResult& res;
   EdgeSamples& edges;
   int x0, y0, x1, y1;  // the tile's pixels: [x0, x1) x [y0, y1)
 
-  static constexpr uint8_t kSampled = 1, kDone = 2;  // the slot holds a sample; its pixel is stored
+  static constexpr uint8_t kDone = 1;
 
   size_t slot(int x, int y) const { return size_t(y - y0) * size_t(x1 - x0 + 1) + size_t(x - x0); }
 
   const CutSample& sample(int x, int y) {
     size_t i = slot(x, y);
     CutSample& cs = slots[i];
-    if (state[i] & kSampled) return *shared[i];
-    state[i] |= kSampled;
+    if (shared[i]) return *shared[i];
     // On a line between tiles: read the sample if the tile on the other side made it,
     // else make it there for both.
     EdgeSamples::Entry* e = edges.at(x, y);
