@@ -469,6 +469,24 @@ TEST(CliRender, ReconstructionCutsByDefaultAndOffOnRequest) {
   EXPECT_EQ(b["reconstruction_samples"].get<int>(), 0);
   nlohmann::json c = stats({"--method", "brute"});
   EXPECT_EQ(c["reconstruct_spacing"].get<int>(), 0);
+  EXPECT_EQ(c["reconstruct_coarse_spacing"].get<int>(), 0);
+  // Coarse cells: twice the spacing by default (a plain lit sphere: its cells agree),
+  // off or larger on request; any other size is refused.
+  EXPECT_EQ(a["reconstruct_coarse_spacing"].get<int>(), 8);
+  EXPECT_GT(a["reconstruction_coarse_cells"].get<int>(), 0);
+  EXPECT_EQ(b["reconstruct_coarse_spacing"].get<int>(), 0);
+  nlohmann::json d = stats({"--reconstruct-coarse", "0"}, "512");
+  EXPECT_EQ(d["reconstruction_coarse_cells"].get<int>(), 0);
+  EXPECT_GT(d["reconstruction_samples"].get<int>(), a["reconstruction_samples"].get<int>());
+  EXPECT_EQ(stats({"--reconstruct", "4", "--reconstruct-coarse", "16"})["reconstruct_coarse_spacing"].get<int>(), 16);
+  for (const char* bad : {"12", "4", "2"}) {
+    CliResult r = run({"render", "s.ray", "-o", "bad.png", "-q", "--width", "32", "--reconstruct", "4",
+                       "--reconstruct-coarse", bad},
+                      dir.path());
+    EXPECT_NE(r.status, 0) << bad;
+    EXPECT_NE(r.err.find("--reconstruct-coarse"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir.file("bad.png")));
+  }
 }
 
 // A scene can come from a pipe (e.g. `lightcuts render <(generator)`): it is read up to

@@ -154,13 +154,15 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         continue;
       }
       bool needsRay = occluded > 0 || partial > 0 || visible == 0;
+      const bool disagree = occluded > 0 || partial > 0;
+      out.disagreements += disagree;
       const float factor = firstOrder == count && exact > 0 ? factorSum / float(exact) : 1.0f;
       const bool batched = !needsRay && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
       if (batched) {
         out.batch.add(lights.lights[n.rep], lights.groups[tree.group], n.intensity * factor);
         out.batchNodes.push_back(uint32_t(out.nodes.size()));
       }
-      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, tree.group, needsRay, batched, factor, t, it.node});
+      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, tree.group, needsRay, batched, disagree, factor, t, it.node});
     }
   }
   for (size_t g = 0; g < out.batchNodes.size(); g += MergedCut::kGroupSize) {
@@ -170,6 +172,26 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         best = out.batchNodes[i];
     out.groupProbe.push_back(best);
   }
+}
+
+float disagreementShare(const LightSet& lights, const MergedCut& cut, const Vec3& p, const Vec3& n) {
+  ShadingPoint sp;
+  sp.p = p;
+  sp.n = n;
+  sp.r = n;
+  sp.kd = Color(1);
+  sp.ks = Color(0);
+  double all = 0, disagreeing = 0;
+  for (const MergedCut::Node& node : cut.nodes) {
+    Color mg;
+    Vec3 wi;
+    float dist;
+    if (!lightContribution(lights.lights[node.rep], lights.groups[node.group], sp, mg, wi, dist)) continue;
+    const double c = luminance(mg * node.intensity);
+    all += c;
+    if (node.disagree) disagreeing += c;
+  }
+  return all > 0 ? float(disagreeing / all) : 0.0f;
 }
 
 namespace {

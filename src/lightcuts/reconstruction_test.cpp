@@ -138,6 +138,42 @@ TEST(Reconstruction, SamplesThatDisagreeSendTheRayAndAgreeingOnesDoNot) {
   EXPECT_EQ(luminance(e.radiance), 0.0f);
 }
 
+// The nodes two samples disagree about are those behind the half-space wall; their share
+// of the diffuse light is about the share of the lights behind it (measured light by
+// light), and nothing where the samples agree.
+TEST(Reconstruction, DisagreementShareIsTheLightOfTheNodesInDispute) {
+  Fixture f;
+  ShadingPoint sp = point(Vec3(0.2f, 0, 0.1f));
+  CutRecord a = f.record(sp, halfBlocked), b = f.record(sp, open);
+  const CutRecord* two[2] = {&a, &b};
+  MergedCut m;
+  f.lc->mergeSamples(two, 2, m);
+  uint32_t disputed = 0;
+  for (const MergedCut::Node& n : m.nodes) disputed += n.disagree;
+  EXPECT_EQ(m.disagreements, disputed);
+  EXPECT_GT(disputed, 0u);
+  double hidden = 0, all = 0;
+  ShadingPoint diffuse = sp;
+  diffuse.kd = Color(1);
+  diffuse.ks = Color(0);
+  for (const Light& l : f.lights.lights) {
+    Color mg;
+    Vec3 wi;
+    float dist;
+    if (!lightContribution(l, f.lights.groups[l.group], diffuse, mg, wi, dist)) continue;
+    double c = luminance(mg * l.intensity);
+    all += c;
+    if (halfBlocked(wi).x == 0) hidden += c;
+  }
+  ASSERT_GT(hidden, 0.1 * all);
+  EXPECT_NEAR(disagreementShare(f.lights, m, sp.p, sp.n), hidden / all, 0.05);
+
+  const CutRecord* same[2] = {&a, &a};
+  f.lc->mergeSamples(same, 2, m);
+  EXPECT_EQ(m.disagreements, 0u);
+  EXPECT_EQ(disagreementShare(f.lights, m, sp.p, sp.n), 0.0f);
+}
+
 TEST(Reconstruction, MergedCutIsAPartitionAccurateAtEverySample) {
   Fixture f;
   // Points a cell apart (the first-order factors they lend each other hold nearby), spread

@@ -27,10 +27,12 @@ Loaded loadCornell() {
   return l;
 }
 
-RenderResult renderWith(const scene::Scene& s, const lightcuts::LightEvaluator& ev, int w, int reconstruct = 0) {
+RenderResult renderWith(const scene::Scene& s, const lightcuts::LightEvaluator& ev, int w, int reconstruct = 0,
+                        int coarse = 0) {
   RenderOptions o;
   o.width = o.height = w;
   o.reconstructSpacing = reconstruct;
+  o.reconstructCoarseSpacing = coarse;
   return render(s, ev, o);
 }
 
@@ -95,6 +97,15 @@ TEST(Accuracy, ReconstructionCutsWithinTwoPercentWithFarFewerShadowRays) {
   // an image this small, edges, where points need their own cuts, are a large share).
   EXPECT_LT(double(rec.stats.eval.shadowRays), 0.7 * double(full.stats.eval.shadowRays));
   for (uint8_t d : rec.done) ASSERT_EQ(d, 1);
+  EXPECT_EQ(rec.stats.reconstructionCoarseCells, 0u);
+
+  // Coarse cells of 8 where their corners agree: fewer samples, the same accuracy.
+  RenderResult coarse = renderWith(s, *lc, W, 4, 8);
+  io::ImageMetrics mc = io::compareImages(ref.image, coarse.image);
+  EXPECT_LE(mc.fraction_over_2pct, 0.01) << "mean " << mc.mean_relative_error << " p99 " << mc.p99_relative_error;
+  EXPECT_GT(coarse.stats.reconstructionCoarseCells, 0u);
+  EXPECT_LT(coarse.stats.reconstructionSamples, rec.stats.reconstructionSamples);
+  for (uint8_t d : coarse.done) ASSERT_EQ(d, 1);
 }
 
 }  // namespace
@@ -107,19 +118,23 @@ TEST(Determinism, ReconstructionCutsImageIsTheSameAtOneAndTwoThreads) {
   Loaded l = loadCornell();
   lightcuts::LightForest forest = lightcuts::buildLightForest(l.scene->lights());
   auto lc = lightcuts::makeLightcuts(l.scene->lights(), forest, lightcuts::CutOptions{});
-  for (int spp : {1, 2}) {
-    RenderOptions o;
-    o.width = 70;  // not a multiple of the spacing or the tile: partial cells and tiles
-    o.height = 45;
-    o.spp = spp;
-    o.reconstructSpacing = 4;
-    o.threads = 1;
-    RenderResult a = render(*l.scene, *lc, o);
-    o.threads = 2;
-    RenderResult b = render(*l.scene, *lc, o);
-    for (size_t i = 0; i < a.image.pixels.size(); ++i) ASSERT_EQ(a.image.pixels[i], b.image.pixels[i]) << spp << " " << i;
-    for (uint8_t d : a.done) ASSERT_EQ(d, 1);
-  }
+  for (int spp : {1, 2})
+    for (int coarse : {0, 8}) {
+      RenderOptions o;
+      o.width = 70;  // not a multiple of the spacing or the tile: partial cells and tiles
+      o.height = 45;
+      o.spp = spp;
+      o.reconstructSpacing = 4;
+      o.reconstructCoarseSpacing = coarse;
+      o.threads = 1;
+      RenderResult a = render(*l.scene, *lc, o);
+      o.threads = 2;
+      RenderResult b = render(*l.scene, *lc, o);
+      for (size_t i = 0; i < a.image.pixels.size(); ++i)
+        ASSERT_EQ(a.image.pixels[i], b.image.pixels[i]) << spp << " " << coarse << " " << i;
+      for (uint8_t d : a.done) ASSERT_EQ(d, 1);
+      EXPECT_EQ(a.stats.reconstructionCoarseCells, b.stats.reconstructionCoarseCells);
+    }
 }
 
 TEST(Determinism, LightcutsImageIsTheSameAtOneAndTwoThreads) {

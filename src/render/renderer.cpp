@@ -94,6 +94,17 @@ constexpr float kSampleMaxPlaneSlope = 0.2f;
 // whole cells.
 constexpr float kSampleMaxFootprints = 3.0f;
 
+// A coarse cell (RenderOptions::reconstructCoarseSpacing) stays whole when the nodes its
+// corner samples disagree about (a shadow boundary crosses it) hold at most this share of
+// their unshadowed light; those nodes get a shadow ray at every point anyway, but many of
+// them mean shadow edges the corners may step over (the church's steps and pews). Where
+// the disagreement is only the emitter's own terminator (the green emitter's walls: a
+// share of 1-5%), the cell stays whole. 0.05 was measured: on the benchmark's scenes the
+// pixels over 2% stay as with cells of S (the church 0.63% vs 0.62%; all four corners
+// trusted whatever they disagree about, 0.89%), and the emitter needs a third fewer
+// samples (docs/LIGHTCUTS.md).
+constexpr float kCoarseMaxDisagreement = 0.05f;
+
 bool sameSurface(int shapeA, const Vec3& pa, const Vec3& na, int shapeB, const Vec3& pb, const Vec3& nb) {
   if (shapeA != shapeB || dot(na, nb) < kSampleMinCos) return false;
   Vec3 d = pb - pa;
@@ -336,7 +347,7 @@ struct ReconstructionTile {
   const RenderOptions& o;
   const RenderOptions& centre;  // o with one sample per pixel
   EvalStats& stats;
-  uint64_t &primary, &secondary, &samples, &fallbacks;
+  uint64_t &primary, &secondary, &samples, &fallbacks, &coarseCells;
   std::vector<CutSample>& slots;
   std::vector<uint8_t>& state;  // per slot: kDone when its pixel is stored
   std::vector<const CutSample*>& shared;  // per slot: its sample (the slot's, or an EdgeSamples one), once made
@@ -386,18 +397,42 @@ struct ReconstructionTile {
     return target;
   }
 
-  float maxSeparation = kInf;
+  float maxSeparation = kInf;  // the footprint limit of cells of S pixels
+  int spacing = 0;  // S: cells larger than this are coarse (kept whole only if they agree)
 
-  void run(int S) {
+  // Cells of C x C pixels (C = S, or the coarse spacing) over the tile.
+  void run(int S, int C) {
     const scene::Camera& cam = scene.camera();
     Vec3 a = normalize(cam.direction(0.5f, 0.5f)), b = normalize(cam.direction(0.5f + 1.0f / float(o.width), 0.5f));
     maxSeparation = kSampleMaxFootprints * float(S) * length(a - b);
+    spacing = S;
     size_t n = size_t(x1 - x0 + 1) * size_t(y1 - y0 + 1);
     if (slots.size() < n) slots.resize(n);
     state.assign(n, 0);
     shared.assign(n, nullptr);
-    for (int cy = y0; cy < y1; cy += S)
-      for (int cx = x0; cx < x1; cx += S) cellPixels(cx, cy, std::min(S, x1 - cx), std::min(S, y1 - cy));
+    for (int cy = y0; cy < y1; cy += C)
+      for (int cx = x0; cx < x1; cx += C) cellPixels(cx, cy, std::min(C, x1 - cx), std::min(C, y1 - cy));
+  }
+
+  // Whether a coarse cell may be rebuilt whole: four corners on one surface, the nodes they
+  // disagree about holding at most kCoarseMaxDisagreement of their merged cut's light (the
+  // merged cut is made here and kept for the cell's pixels).
+  bool coarseAgrees(const CutSample* const* corners, int n) {
+    if (n != 4) return false;
+    for (int i = 0; i < 4; ++i) {
+      if (!corners[i]->cut.valid) return false;
+      for (int j = i + 1; j < 4; ++j)
+        if (!sameSurface(corners[i]->shape, corners[i]->p, corners[i]->n, corners[j]->shape, corners[j]->p,
+                         corners[j]->n))
+          return false;
+    }
+    const lightcuts::CutRecord* cuts[4];
+    for (int i = 0; i < 4; ++i) cuts[i] = &corners[i]->cut;
+    lightcuts::MergedCut& merged = cell.merged[15];
+    ev.mergeSamples(cuts, 4, merged);
+    cell.ready[15] = true;
+    return merged.disagreements == 0 ||
+           lightcuts::disagreementShare(scene.lights(), merged, corners[0]->p, corners[0]->n) <= kCoarseMaxDisagreement;
   }
 
   // The surface a pixel centre's ray shades (false: none).
@@ -442,9 +477,15 @@ struct ReconstructionTile {
     hook.count = n;
     hook.cell = &cell;
     hook.eye = scene.camera().eye;
-    hook.maxSeparation = maxSeparation;
+    const bool coarse = w > spacing || h > spacing;
+    // The footprint limit grows with the cell (a coarse cell's points lie farther from
+    // its corners), so on a surface seen face on the cell stays whole.
+    hook.maxSeparation = coarse ? maxSeparation * float(std::max(w, h)) / float(spacing) : maxSeparation;
     bool left = false;  // pixels this cell's samples cannot serve
-    for (int y = cy; y < cy + h; ++y)
+    const bool split = coarse && !coarseAgrees(corners, n);  // at once: its pixels wait for finer cells
+    left = split;
+    coarseCells += coarse && !split;
+    for (int y = cy; y < cy + h && !split; ++y)
       for (int x = cx; x < cx + w; ++x) {
         uint8_t& st = state[slot(x, y)];
         if (st & kDone) continue;
@@ -555,6 +596,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     std::vector<CutSample> slots;   // reconstruction samples of the current tile, per pixel
     std::vector<uint8_t> slotState;
     std::vector<const CutSample*> slotSample;
+    uint64_t coarseCells = 0;
     CellCuts cell;                  // merged cuts of the current cell
   };
   tbb::enumerable_thread_specific<Local> locals;
@@ -564,7 +606,8 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   // tiles (EdgeSamples).
   const int S = o.reconstructSpacing;
   const bool recon = S > 1 && evaluator.supportsReconstruction();
-  const int kTile = recon ? (64 + S - 1) / S * S : 16;
+  const int C = std::max(S, o.reconstructCoarseSpacing);
+  const int kTile = recon ? (64 + C - 1) / C * C : 16;
   RenderOptions centre = o;  // samples are traced through pixel centres
   centre.spp = 1;
   centre.progress = nullptr;
@@ -604,8 +647,8 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
           continue;
         }
         ReconstructionTile rt{scene, evaluator, o, centre, L.stats, L.primary, L.secondary, L.samples, L.fallbacks,
-                              L.slots, L.slotState, L.slotSample, L.cell, res, edges, x0, y0, x1, y1};
-        rt.run(S);
+                              L.coarseCells, L.slots, L.slotState, L.slotSample, L.cell, res, edges, x0, y0, x1, y1};
+        rt.run(S, C);
         ++tilesDone;
       }
   });
@@ -626,6 +669,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     res.stats.secondaryRays += L.secondary;
     res.stats.reconstructionSamples += L.samples;
     res.stats.reconstructionFallbacks += L.fallbacks;
+    res.stats.reconstructionCoarseCells += L.coarseCells;
   }
 
   // Brute force at sampled pixels: the measured error, and what a full brute-force image

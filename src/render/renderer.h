@@ -31,6 +31,11 @@ struct RenderOptions {
   // every Nth pixel in x and y, the primary hits in between rebuilt from the four around
   // them when they lie on the same surface. 0 or 1 = a full lightcut everywhere.
   int reconstructSpacing = 0;
+  // Larger cells first (a multiple of reconstructSpacing by a power of two; 0 = none): a
+  // cell of this size is rebuilt from its four corner samples when they lie on one surface
+  // and agree on the visibility of every node of their merged cut; otherwise it splits
+  // down to reconstructSpacing (and below, where pixels are not served).
+  int reconstructCoarseSpacing = 0;
   // Set from a signal handler to stop early; the result is marked interrupted.
   std::atomic<bool>* cancel = nullptr;
   // Called from one thread with the fraction done (0..1), about ten times a second.
@@ -54,6 +59,7 @@ struct RenderStats {
   uint64_t primaryRays = 0;
   uint64_t reconstructionSamples = 0;  // full lightcuts recorded as samples
   uint64_t reconstructionFallbacks = 0;  // primary hits whose samples did not match: full cuts
+  uint64_t reconstructionCoarseCells = 0;  // cells of reconstructCoarseSpacing kept whole
   uint64_t secondaryRays = 0;  // reflection and refraction
   lightcuts::EvalStats eval;
   ReferenceStats reference;
