@@ -301,18 +301,27 @@ void storePixel(RenderResult& res, int width, int x, int y, const PixelResult& p
 // Samples on the lines where tiles meet, shared by the tiles on both sides: the first
 // tile to need one computes it, the other reads it. A tile that finds one being computed
 // computes its own copy (the same values: a sample depends only on its pixel), so no
-// thread waits on another. The shared samples are kept until the render ends: at 2048 x
-// 2048 the green emitter peaks at 235 MB (166 MB before this and the criterion's
-// recalibration); freeing each once all its tiles are done would bound that.
+// thread waits on another. Each entry counts the tiles that may use it (two, four where
+// four tiles meet); when the last of them is done the sample's cut is freed, so only the
+// lines along unfinished tiles hold memory.
 class EdgeSamples {
  public:
   EdgeSamples(int width, int height, int tile)
       : width_(width), height_(height), tile_(tile),
         linesX_(std::max(0, (width - 1) / tile)), linesY_(std::max(0, (height - 1) / tile)),
-        entries_(size_t(linesX_) * size_t(height) + size_t(linesY_) * size_t(width)) {}
+        entries_(size_t(linesX_) * size_t(height) + size_t(linesY_) * size_t(width)) {
+    // A pixel on a vertical line is used by the tiles left and right of it, and, when it
+    // is on a horizontal line too, by those above and below them.
+    for (int k = 1; k <= linesX_; ++k)
+      for (int y = 0; y < height_; ++y) at(k * tile_, y)->users = onLineY(y) ? 4 : 2;
+    for (int m = 1; m <= linesY_; ++m)
+      for (int x = 0; x < width_; ++x)
+        if (!onLineX(x)) at(x, m * tile_)->users = 2;
+  }
 
   struct Entry {
     std::atomic<uint8_t> state{0};  // kEmpty, kBusy or kReady
+    std::atomic<uint8_t> users{0};  // tiles that may still read it
     CutSample sample;
     PixelResult pixel;
   };
@@ -320,14 +329,34 @@ class EdgeSamples {
 
   // The entry of pixel (x, y) if it lies on a line between tiles, else null.
   Entry* at(int x, int y) {
-    if (x > 0 && x % tile_ == 0 && x / tile_ <= linesX_)
-      return &entries_[size_t(x / tile_ - 1) * size_t(height_) + size_t(y)];
-    if (y > 0 && y % tile_ == 0 && y / tile_ <= linesY_)
+    if (onLineX(x)) return &entries_[size_t(x / tile_ - 1) * size_t(height_) + size_t(y)];
+    if (onLineY(y))
       return &entries_[size_t(linesX_) * size_t(height_) + size_t(y / tile_ - 1) * size_t(width_) + size_t(x)];
     return nullptr;
   }
 
+  // The tile of pixels [x0, x1) x [y0, y1) is done: it reads none of the samples on its
+  // border again (its cells' corners reach x1 and y1, clipped to the image).
+  void tileDone(int x0, int y0, int x1, int y1) {
+    const int xe = std::min(x1, width_ - 1), ye = std::min(y1, height_ - 1);
+    auto release = [&](int x, int y) {
+      Entry* e = at(x, y);
+      if (e && e->users.fetch_sub(1, std::memory_order_acq_rel) == 1) e->sample.cut = lightcuts::CutRecord{};
+    };
+    for (int x = x0; x <= xe; ++x) {
+      release(x, y0);
+      if (ye != y0) release(x, ye);
+    }
+    for (int y = y0 + 1; y < ye; ++y) {
+      release(x0, y);
+      if (xe != x0) release(xe, y);
+    }
+  }
+
  private:
+  bool onLineX(int x) const { return x > 0 && x % tile_ == 0 && x / tile_ <= linesX_; }
+  bool onLineY(int y) const { return y > 0 && y % tile_ == 0 && y / tile_ <= linesY_; }
+
   int width_, height_, tile_, linesX_, linesY_;
   std::vector<Entry> entries_;
 };
@@ -649,6 +678,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
         ReconstructionTile rt{scene, evaluator, o, centre, L.stats, L.primary, L.secondary, L.samples, L.fallbacks,
                               L.coarseCells, L.slots, L.slotState, L.slotSample, L.cell, res, edges, x0, y0, x1, y1};
         rt.run(S, C);
+        edges.tileDone(x0, y0, x1, y1);
         ++tilesDone;
       }
   });
