@@ -27,6 +27,7 @@
 #include <cmath>
 #include <array>
 #include <queue>
+#include <unordered_map>
 
 #include "lightcuts/cluster.h"
 
@@ -417,11 +418,17 @@ class ApproximateClustering {
     double c = std::pow(double(kGroup), 1 - kAlpha) / 2;
     return std::max<size_t>(1, size_t(std::ceil(c * std::pow(double(n), kAlpha))));
   }
-  // How many clusters the recursion over n lights returns (depends on n alone).
+  // How many clusters the recursion over n lights returns (depends on n alone). Memoized:
+  // every level of the recursion asks it for its halves, which have at most two sizes.
   static size_t survivors(size_t n) {
     if (n <= kGroup) return std::min(n, keep(n));
+    static thread_local std::unordered_map<size_t, size_t> memo;
+    auto it = memo.find(n);
+    if (it != memo.end()) return it->second;
     size_t h = n / 2;
-    return std::min(survivors(h) + survivors(n - h), keep(n));
+    size_t r = std::min(survivors(h) + survivors(n - h), keep(n));
+    memo.emplace(n, r);
+    return r;
   }
 
   // Clusters the leaves order[b, e) (Morton order); merged clusters take ids from
@@ -463,20 +470,30 @@ class ApproximateClustering {
     return (a.weight + x.weight) * m;
   }
 
-  // Greedy merging inside a small set, nearest neighbours by brute force.
+  // Greedy merging inside a small set, nearest neighbours by brute force over a matrix of
+  // the metric between the set's slots (dm[i * stride + j] = metric(set[i], set[j]), both
+  // orders, as the metric's rounding is not symmetric): a merge computes the new cluster's
+  // row and column once, and a cluster whose neighbour was merged rescans its row.
   void combine(std::vector<int32_t>& set, size_t target, int32_t idBase) {
     size_t m = set.size();
     if (m <= target) return;
+    const size_t stride = m;
+    static thread_local std::vector<float> dm;
+    dm.resize(m * m);
+    auto D = [&](size_t i, size_t j) -> float& { return dm[i * stride + j]; };
+    for (size_t i = 0; i < m; ++i)
+      for (size_t j = 0; j < m; ++j)
+        if (j != i) D(i, j) = metric(all_[size_t(set[i])], all_[size_t(set[j])]);
     std::vector<float> nnD(m, kInf);
     std::vector<int32_t> nn(m, -1);
     auto refresh = [&](size_t i) {
       nnD[i] = kInf;
       nn[i] = -1;
+      const float* row = &dm[i * stride];
       for (size_t j = 0; j < m; ++j) {
         if (j == i) continue;
-        float d = metric(all_[size_t(set[i])], all_[size_t(set[j])]);
-        if (d < nnD[i]) {
-          nnD[i] = d;
+        if (row[j] < nnD[i]) {
+          nnD[i] = row[j];
           nn[i] = int32_t(j);
         }
       }
@@ -491,24 +508,35 @@ class ApproximateClustering {
       int32_t id = next++;
       all_[size_t(id)] = detail::mergeClusters(all_[size_t(set[i])], all_[size_t(set[j])], set[i], set[j],
                                                withCone_, seed_);
-      // The merged cluster takes i's place; the last one moves into j's.
+      // The merged cluster takes i's place; the last one moves into j's (its row and
+      // column with it).
       set[i] = id;
       size_t last = m - 1;
       set[j] = set[last];
       nnD[j] = nnD[last];
       nn[j] = nn[last];
+      if (j != last)
+        for (size_t k = 0; k < last; ++k) {
+          D(j, k) = D(last, k);
+          D(k, j) = D(k, last);
+        }
       --m;
       set.resize(m);
       for (size_t k = 0; k < m; ++k)
         if (nn[k] == int32_t(last)) nn[k] = int32_t(j);
       if (i == last) i = j;
+      for (size_t k = 0; k < m; ++k) {
+        if (k == i) continue;
+        D(i, k) = metric(all_[size_t(set[i])], all_[size_t(set[k])]);
+        D(k, i) = metric(all_[size_t(set[k])], all_[size_t(set[i])]);
+      }
       refresh(i);
       for (size_t k = 0; k < m; ++k) {
         if (k == i) continue;
         if (nn[k] == int32_t(i) || nn[k] == int32_t(j) || nn[k] < 0) {
           refresh(k);
         } else {
-          float d = metric(all_[size_t(set[k])], all_[size_t(set[i])]);
+          float d = D(k, i);
           if (d < nnD[k]) {
             nnD[k] = d;
             nn[k] = int32_t(i);
