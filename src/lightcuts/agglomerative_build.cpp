@@ -469,6 +469,22 @@ class ApproximateClustering {
     }
     return (a.weight + x.weight) * m;
   }
+  // metric(a, x) and metric(x, a) at once, bit for bit: they share all but the cone
+  // union's rounding (ta + td + tb is summed in the arguments' order).
+  void metricPair(const Cluster& a, const Cluster& x, float& ax, float& xa) const {
+    Vec3 e = vmax(a.hi, x.hi) - vmin(a.lo, x.lo);
+    float m = dot(e, e), m2 = m;
+    if (withCone_) {
+      float td = fastAcos(dot(a.axis, x.axis));
+      float u1 = unionHalfAngle(a.halfAngle, x.halfAngle, td), u2 = unionHalfAngle(x.halfAngle, a.halfAngle, td);
+      float o1 = oneMinusCos(u1), o2 = u2 == u1 ? o1 : oneMinusCos(u2);
+      m += c2_ * o1 * o1;
+      m2 += c2_ * o2 * o2;
+    }
+    const float w = a.weight + x.weight;
+    ax = w * m;
+    xa = w * m2;
+  }
 
   // Greedy merging inside a small set, nearest neighbours by brute force over a matrix of
   // the metric between the set's slots (dm[i * stride + j] = metric(set[i], set[j]), both
@@ -482,8 +498,7 @@ class ApproximateClustering {
     dm.resize(m * m);
     auto D = [&](size_t i, size_t j) -> float& { return dm[i * stride + j]; };
     for (size_t i = 0; i < m; ++i)
-      for (size_t j = 0; j < m; ++j)
-        if (j != i) D(i, j) = metric(all_[size_t(set[i])], all_[size_t(set[j])]);
+      for (size_t j = i + 1; j < m; ++j) metricPair(all_[size_t(set[i])], all_[size_t(set[j])], D(i, j), D(j, i));
     std::vector<float> nnD(m, kInf);
     std::vector<int32_t> nn(m, -1);
     auto refresh = [&](size_t i) {
@@ -527,8 +542,7 @@ class ApproximateClustering {
       if (i == last) i = j;
       for (size_t k = 0; k < m; ++k) {
         if (k == i) continue;
-        D(i, k) = metric(all_[size_t(set[i])], all_[size_t(set[k])]);
-        D(k, i) = metric(all_[size_t(set[k])], all_[size_t(set[i])]);
+        metricPair(all_[size_t(set[i])], all_[size_t(set[k])], D(i, k), D(k, i));
       }
       refresh(i);
       for (size_t k = 0; k < m; ++k) {
