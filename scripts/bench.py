@@ -634,8 +634,9 @@ class Driver:
                  "with a shadow ray. Ours gives two figures per shading point: the cut size (light-tree nodes whose "
                  "light is evaluated) and the shadow rays sent. Lightcuts runs with its defaults: first-order "
                  "estimates, visibility probes and reconstruction cuts (`--reconstruct auto`, every 4 pixels at "
-                 "512×512, every 8 where the corners of a cell of 8 agree): points between samples evaluate their samples' merged cut (the finer cut where the "
-                 "samples' visibility differs, the coarser where all saw it visible and smooth), borrowing "
+                 "512×512, every 8 where the corners of a cell of 8 agree): points between samples evaluate their "
+                 "samples' merged cut (the finer cut where the samples' visibility differs, the coarser where all "
+                 "saw it visible and smooth), borrowing "
                  "visibility where the samples agree, so most of their nodes need no shadow ray.")
         L.append("")
 

@@ -136,7 +136,6 @@ TEST(Agglomerative, MergesNearbyLightsFirst) {
   EXPECT_EQ(leafCount(t, t.nodes[0].left + 1), 8u);
 }
 
-// The seed split falls at a gap in position rather than at the median.
 // Larger sets are clustered bottom-up in Morton-ordered groups first (Gu et al. 2013): the
 // tree must still be a valid hierarchy, the same at any thread count, and about as good as
 // the exact greedy one by the merge metric's own measure (box diagonal squared times
@@ -169,6 +168,7 @@ TEST(Agglomerative, BottomUpGroupsGiveAValidDeterministicTree) {
   }
 }
 
+// The seed split falls at a gap in position rather than at the median.
 TEST(SeedBuild, SplitsAtTheLargestGap) {
   LightSet set;
   set.groups.push_back(LightGroup{});

@@ -155,7 +155,6 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       }
       bool needsRay = occluded > 0 || partial > 0 || visible == 0;
       const bool disagree = occluded > 0 || partial > 0;
-      out.disagreements += disagree;
       const float factor = firstOrder == count && exact > 0 ? factorSum / float(exact) : 1.0f;
       const bool batched = !needsRay && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
       if (batched) {

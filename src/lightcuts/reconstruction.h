@@ -77,7 +77,9 @@ struct MergedCut {
     uint16_t group;
     bool needsRay;    // the samples disagree, went through glass, or tested nothing
     bool batched;     // also in `batch` (no ray, an omni or oriented light)
-    bool disagree;    // the samples disagree about its visibility, or saw it through glass
+    // The samples disagree about its visibility (some found it occluded, some not), or saw
+    // it through glass: a shadow boundary may cross the samples' span.
+    bool disagree;
     // The first-order factor (CutRecord::factor) of the samples whose cut holds the node,
     // averaged, when every sample used first-order estimates there; else 1.
     float factor;
@@ -85,9 +87,6 @@ struct MergedCut {
   };
   std::vector<Node> nodes;  // without the nodes every sample found occluded
   uint32_t occluded = 0;    // how many those were (they are in the cut, contributing 0)
-  // Nodes whose samples disagree about visibility (some found them occluded, some not) or
-  // saw them through glass (Node::disagree): a shadow boundary may cross the samples' span.
-  uint32_t disagreements = 0;
   MergedBatch batch;        // the batched nodes again, four lanes at a time
   // The batched nodes in groups of kGroupSize, in batch order (neighbours in the tree:
   // lights near each other). Each group has a probe, its brightest node: a point sends it
@@ -100,7 +99,6 @@ struct MergedCut {
   void clear() {
     nodes.clear();
     occluded = 0;
-    disagreements = 0;
     batch.clear();
     batchNodes.clear();
     groupProbe.clear();

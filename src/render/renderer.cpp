@@ -460,8 +460,7 @@ struct ReconstructionTile {
     lightcuts::MergedCut& merged = cell.merged[15];
     ev.mergeSamples(cuts, 4, merged);
     cell.ready[15] = true;
-    return merged.disagreements == 0 ||
-           lightcuts::disagreementShare(scene.lights(), merged, corners[0]->p, corners[0]->n) <= kCoarseMaxDisagreement;
+    return lightcuts::disagreementShare(scene.lights(), merged, corners[0]->p, corners[0]->n) <= kCoarseMaxDisagreement;
   }
 
   // The surface a pixel centre's ray shades (false: none).
@@ -510,9 +509,8 @@ struct ReconstructionTile {
     // The footprint limit grows with the cell (a coarse cell's points lie farther from
     // its corners), so on a surface seen face on the cell stays whole.
     hook.maxSeparation = coarse ? maxSeparation * float(std::max(w, h)) / float(spacing) : maxSeparation;
-    bool left = false;  // pixels this cell's samples cannot serve
     const bool split = coarse && !coarseAgrees(corners, n);  // at once: its pixels wait for finer cells
-    left = split;
+    bool left = split;  // pixels this cell's samples cannot serve
     coarseCells += coarse && !split;
     for (int y = cy; y < cy + h && !split; ++y)
       for (int x = cx; x < cx + w; ++x) {

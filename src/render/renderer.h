@@ -33,8 +33,9 @@ struct RenderOptions {
   int reconstructSpacing = 0;
   // Larger cells first (a multiple of reconstructSpacing by a power of two; 0 = none): a
   // cell of this size is rebuilt from its four corner samples when they lie on one surface
-  // and agree on the visibility of every node of their merged cut; otherwise it splits
-  // down to reconstructSpacing (and below, where pixels are not served).
+  // and the nodes of their merged cut they disagree about hold little of its light (see
+  // kCoarseMaxDisagreement in renderer.cpp); otherwise it splits down to
+  // reconstructSpacing (and below, where pixels are not served).
   int reconstructCoarseSpacing = 0;
   // Set from a signal handler to stop early; the result is marked interrupted.
   std::atomic<bool>* cancel = nullptr;
