@@ -843,9 +843,9 @@ class Driver:
                      f"{100 * (r['err_seed'].get('fraction_over_2pct') or 0):.0f}% of pixels over 2%)")
         r = row("green")
         if r:
-            g.append(f"- the same on the 2,011-light emitter: {r['lc_lights']:.1f} cut nodes / "
-                     f"{r.get('lc_shadow_rays', r['lc_lights']):.1f} shadow rays against the seed's 1.5 — "
-                     f"{mark(r.get('lc_shadow_rays', r['lc_lights']) < 1.50233)} (a bound of 2% with 2,011 lights "
+            n, rays = r["lights"]["total"], r.get("lc_shadow_rays", r["lc_lights"])
+            g.append(f"- the same on the {n:,}-light emitter: {r['lc_lights']:.1f} cut nodes / {rays:.1f} shadow "
+                     f"rays against the seed's 1.5 — {mark(rays < 1.50233)} (a bound of 2% with {n:,} lights "
                      f"this close to their receivers needs ~{r['lc_lights']:.0f} clusters; the seed's method here: "
                      f"{r['seed_lights']:.1f} lights, {100 * (r['err_seed'].get('fraction_over_2pct') or 0):.0f}% of "
                      "pixels over 2%)")
