@@ -10,11 +10,14 @@
 namespace lc::app {
 
 ProgressBar::ProgressBar(std::string label, bool quiet)
-    : label_(std::move(label)), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0),
-      start_(std::chrono::steady_clock::now()) {}
+    : label_(std::move(label)), quiet_(quiet), tty_(isatty(STDERR_FILENO) != 0) {}
 
 void ProgressBar::update(double f) {
   if (quiet_) return;
+  if (!started_) {
+    started_ = true;
+    start_ = std::chrono::steady_clock::now();
+  }
   double el = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   // Short renders print nothing; the final update only closes a bar that was shown.
   if (el < 1.0 && !shown_) return;

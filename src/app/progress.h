@@ -1,6 +1,7 @@
 // A progress bar with ETA on stderr: redrawn in place on a terminal, a few plain lines
-// otherwise (logs, CI), nothing when quiet. It stays silent for the first second, so short
-// renders print nothing but their summary.
+// otherwise (logs, CI), nothing when quiet. It stays silent for the first second after its
+// first update (the phase's start), so short phases print nothing. One bar per phase: scene
+// phases, tree build, render and reference pixels each have their own.
 #pragma once
 
 #include <chrono>
@@ -16,7 +17,7 @@ class ProgressBar {
 
  private:
   std::string label_;
-  bool quiet_, tty_, shown_ = false;
+  bool quiet_, tty_, started_ = false, shown_ = false;
   int lastDecile_ = -1;
   std::chrono::steady_clock::time_point start_;
 };

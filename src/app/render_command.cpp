@@ -147,7 +147,10 @@ int runRender(RenderArgs& a) {
   if (method == lightcuts::Method::Brute) {
     evaluator = lightcuts::makeBruteForce(scene.lights());
   } else {
+    ProgressBar bar("light tree", a.quiet);
+    tb.progress = [&](double f) { bar.update(f); };
     forest = lightcuts::buildLightForest(scene.lights(), tb);
+    bar.finish();
     evaluator = method == lightcuts::Method::Seed ? lightcuts::makeSeedCuts(scene.lights(), forest, co)
                                                   : lightcuts::makeLightcuts(scene.lights(), forest, co);
   }
@@ -165,10 +168,13 @@ int runRender(RenderArgs& a) {
   ro.cancel = &gInterrupted;
   ProgressBar bar("rendering", a.quiet);
   ro.progress = [&](double f) { bar.update(f); };
+  ProgressBar refBar("reference pixels", a.quiet);
+  ro.referenceProgress = [&](double f) { refBar.update(f); };
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   render::RenderResult rr = render::render(scene, *evaluator, ro);
   bar.finish();
+  refBar.finish();
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
 
@@ -212,6 +218,7 @@ int runRender(RenderArgs& a) {
     j["visibility_probes"] = a.visibilityProbes;
     j["probed_clusters"] = es.probedClusters;
     j["probe_rays"] = es.probeRays;
+    j["occluded_shadow_rays"] = es.occludedRays;
     j["hidden_clusters"] = es.hiddenClusters;
     j["group_probes"] = es.groupProbes;
     j["failed_group_probes"] = es.failedGroupProbes;
@@ -299,9 +306,10 @@ int runRender(RenderArgs& a) {
                                    formatCount(double(rr.stats.reconstructionCoarseCells)), ro.reconstructCoarseSpacing)
                      : std::string(),
                  formatCount(double(es.reconstructedPoints)), formatCount(double(rr.stats.reconstructionFallbacks)));
-    fmt::print("time       {} total: load {}, accel {}, lights {}, tree {}, render {}\n", formatSeconds(total),
+    fmt::print("time       {} total: load {}, accel {}, lights {}, tree {}, render {}{}\n", formatSeconds(total),
                formatSeconds(ls.loadSeconds), formatSeconds(ls.accelSeconds), formatSeconds(ls.lightSeconds),
-               formatSeconds(forest.buildSeconds), formatSeconds(rr.stats.seconds));
+               formatSeconds(forest.buildSeconds), formatSeconds(rr.stats.seconds),
+               ref.pixels > 0 ? ", reference " + formatSeconds(ref.bruteSeconds) : std::string());
     fmt::print("rays       {} primary, {} secondary, {} shadow ({} rays/s)\n", formatCount(double(rr.stats.primaryRays)),
                formatCount(double(rr.stats.secondaryRays)), formatCount(double(es.shadowRays)),
                formatCount(rr.stats.seconds > 0 ? double(allRays) / rr.stats.seconds : 0));

@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "app/progress.h"
 #include "core/file_util.h"
 #include "io/obj_loader.h"
 #include "io/ray_parser.h"
@@ -39,7 +40,12 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
   auto t2 = Clock::now();
   lights::ObjectLightOptions olo = o.objectLights;
   olo.maxLights = o.limits.maxLights;
-  out.objectLights = lights::addObjectLights(*out.scene, olo);
+  {
+    ProgressBar bar("object lights", o.quiet);
+    olo.progress = [&](double f) { bar.update(f); };
+    out.objectLights = lights::addObjectLights(*out.scene, olo);
+    bar.finish();
+  }
   if (o.gi) {
     lights::VplOptions v;
     const auto& ir = desc.instantRadiosity;
@@ -56,7 +62,12 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
     if (o.vplClamp) v.clamp = *o.vplClamp;
     if (o.vplSeed != 1 || !(ir && ir->seed)) v.seed = o.vplSeed;
     v.maxVpls = o.limits.maxVpls;
-    if (v.count > 0) out.vpls = lights::addVpls(*out.scene, v);
+    if (v.count > 0) {
+      ProgressBar bar("VPLs", o.quiet);
+      v.progress = [&](double f) { bar.update(f); };
+      out.vpls = lights::addVpls(*out.scene, v);
+      bar.finish();
+    }
   }
   if (out.scene->lights().size() > o.limits.maxLights)
     throw Error("the scene has " + std::to_string(out.scene->lights().size()) +

@@ -569,7 +569,10 @@ class ApproximateClustering {
 }  // namespace
 
 LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint32_t>& indices,
-                                 LightType type, float coneWeight, uint64_t seed, size_t exactLimit) {
+                                 LightType type, float coneWeight, uint64_t seed, size_t exactLimit,
+                                 Progress* progress) {
+  // Progress counts lights: the bottom-up chunks take most of a large build.
+  constexpr double kChunkShare = 0.85;
   LightTree tree;
   tree.type = type;
   if (indices.empty()) return tree;
@@ -611,6 +614,7 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
       size_t begin = c * chunk, end = std::min(n, begin + chunk);
       ApproximateClustering aac(clusters, withCone, coneWeight, seed);
       survivors[c] = aac.run(order, begin, end, idBase[c]);
+      if (progress) progress->add(kChunkShare * double(end - begin));
     });
     for (const auto& s : survivors) top.insert(top.end(), s.begin(), s.end());
   }
@@ -619,6 +623,7 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   std::vector<int32_t> root = builder.reduce(clusters, top, 1, nextId, created, true);
   std::copy(created.begin(), created.end(), clusters.begin() + nextId);
   detail::layoutTree(clusters, root[0], tree);
+  if (progress) progress->add(n <= exactLimit ? double(n) : (1 - kChunkShare) * double(n));
   return tree;
 }
 

@@ -91,6 +91,7 @@ inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoin
   res.found = isBlack(v) ? CutVisibility::Occluded
               : (v.x == 1 && v.y == 1 && v.z == 1) ? CutVisibility::Visible
                                                     : CutVisibility::Partial;
+  stats.occludedRays += res.found == CutVisibility::Occluded;
   return mg * v;
 }
 

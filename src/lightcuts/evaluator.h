@@ -70,6 +70,7 @@ struct EvalStats {
   uint64_t reconstructedPoints = 0;  // shading points given a reconstruction cut
   uint64_t probedClusters = 0;       // clusters tested for being hidden as a whole
   uint64_t probeRays = 0;            // the shadow rays those tests cast (in shadowRays too)
+  uint64_t occludedRays = 0;         // shadow rays that found their light hidden
   uint64_t hiddenClusters = 0;       // clusters kept in a cut as hidden by their probes
   uint64_t groupProbes = 0;          // rays testing groups of borrowed-visible nodes (reconstruction.h)
   uint64_t failedGroupProbes = 0;    // those groups found hidden where every sample saw them
@@ -90,6 +91,7 @@ struct EvalStats {
     reconstructedPoints += o.reconstructedPoints;
     probedClusters += o.probedClusters;
     probeRays += o.probeRays;
+    occludedRays += o.occludedRays;
     hiddenClusters += o.hiddenClusters;
     groupProbes += o.groupProbes;
     failedGroupProbes += o.failedGroupProbes;

@@ -178,6 +178,9 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
   forest.trees.resize(groups.size());
   std::vector<std::pair<GroupKey, const std::vector<uint32_t>*>> work;
   for (auto& [k, v] : groups) work.emplace_back(k, &v);
+  double total = 0;
+  for (auto& [k, v] : groups) total += double(v.size());
+  Progress progress(options.progress, total);
   // Trees are independent; build them side by side (each builder is itself parallel).
   tbb::parallel_for(size_t(0), work.size(), [&](size_t i) {
     const GroupKey& k = work[i].first;
@@ -186,6 +189,7 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
     LightTree t;
     if (options.builder == TreeBuilder::Seed) {
       t = buildSeedTree(lights, idx, k.type, seed);
+      progress.add(double(idx.size()));
     } else {
       // c weights the normal cone for lights whose emission depends on direction.
       float c = 0;
@@ -197,7 +201,7 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
           c = b.diagonal();
         }
       }
-      t = buildAgglomerativeTree(lights, idx, k.type, c, seed, std::max<size_t>(options.exactLimit, 2));
+      t = buildAgglomerativeTree(lights, idx, k.type, c, seed, std::max<size_t>(options.exactLimit, 2), &progress);
       computeSeedData(lights, t);
     }
     computePreorder(t);
@@ -205,6 +209,7 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
     t.group = k.group;
     forest.trees[i] = std::move(t);
   });
+  progress.finish();
   forest.buildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return forest;
 }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "core/progress.h"
 #include "scene/light.h"
 
 namespace lc::lightcuts {
@@ -73,6 +74,7 @@ struct TreeBuildOptions {
   // c of the metric for oriented and spot lights: the scene's diagonal (Walter et al.). 0 =
   // the diagonal of the tree's own lights (for callers that know no scene).
   float sceneDiagonal = 0;
+  ProgressFn progress = {};  // called with the share of lights clustered (core/progress.h)
 };
 
 struct LightForest {
@@ -104,7 +106,7 @@ inline float clusterMetric(float intensity, const Vec3& lo, const Vec3& hi, floa
 // Builders over a list of light indices of one type and group (used by buildLightForest).
 LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint32_t>& indices,
                                  LightType type, float coneWeight, uint64_t seed,
-                                 size_t exactLimit = 8192);
+                                 size_t exactLimit = 8192, Progress* progress = nullptr);
 LightTree buildSeedTree(const LightSet& lights, const std::vector<uint32_t>& indices, LightType type,
                         uint64_t seed);
 

@@ -681,6 +681,7 @@ std::vector<ObjectLightInfo> addObjectLights(scene::Scene& scene, const ObjectLi
   std::vector<ObjectLightInfo> infos;
   size_t base = set.lights.size();
   set.lights.resize(base + size_t(total));
+  Progress progress(options.progress, total);
   for (Emitter& e : emitters) {
     const Luminosity& l = *e.lum;
     LightGroup g;
@@ -713,6 +714,7 @@ std::vector<ObjectLightInfo> addObjectLights(scene::Scene& scene, const ObjectLi
     info.power = Color(float(pw[0]), float(pw[1]), float(pw[2]));
     infos.push_back(std::move(info));
     base += n;
+    progress.add(double(n));
   }
   return infos;
 }

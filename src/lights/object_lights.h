@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/progress.h"
 #include "scene/scene.h"
 
 namespace lc::lights {
@@ -27,6 +28,7 @@ struct ObjectLightOptions {
   Placement placement = Placement::Stratified;
   uint64_t maxLights = 20'000'000;  // --max-lights
   uint64_t seed = 1;  // unused so far: placement is a deterministic function of the geometry
+  ProgressFn progress = {};  // called with the share of lights placed (core/progress.h)
 };
 
 // What was generated for one luminous object (for `lightcuts info` and --stats).

@@ -124,6 +124,7 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
   size_t blocks = (n + kBlock - 1) / kBlock;
   std::vector<std::vector<Deposit>> out(blocks);
   const float eps = scene.epsilon();
+  Progress progress(o.progress, double(n));
   tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
     std::vector<Deposit>& dep = out[b];
     for (size_t p = b * kBlock; p < std::min(n, (b + 1) * kBlock); ++p) {
@@ -184,7 +185,9 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
         origin = scene.offsetOrigin(h, dir);
       }
     }
+    progress.add(double(std::min(n, (b + 1) * kBlock) - b * kBlock));
   });
+  progress.finish();
 
   size_t count = 0;
   for (const auto& d : out) count += d.size();

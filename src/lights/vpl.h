@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 
+#include "core/progress.h"
 #include "scene/scene.h"
 
 namespace lc::lights {
@@ -23,6 +24,7 @@ struct VplOptions {
   float clamp = 0.05f; // --vpl-clamp: minimum distance, as a fraction of half the scene diagonal
   uint64_t seed = 1;
   uint64_t maxVpls = 10'000'000;
+  ProgressFn progress = {};  // called with the share of paths shot (core/progress.h)
 };
 
 struct VplInfo {

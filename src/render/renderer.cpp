@@ -710,10 +710,19 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     uint64_t dummyA = 0, dummyB = 0;
     auto tb = Clock::now();
     tbb::enumerable_thread_specific<EvalStats> bs;
+    Progress progress(o.referenceProgress, double(px.size()));
     tbb::parallel_for(size_t(0), px.size(), [&](size_t i) {
+      if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
       uint64_t a = 0, b = 0;
       ref[i] = renderPixel(scene, *brute, o, px[i].first, px[i].second, bs.local(), a, b).color;
+      progress.add(1);
     });
+    progress.finish();
+    // Stopped during the reference: the image is whole, but the run is interrupted.
+    if (o.cancel && o.cancel->load()) {
+      res.interrupted = true;
+      return res;
+    }
     res.stats.reference.bruteSeconds = secondsSince(tb);
     for (const EvalStats& s : bs) bruteStats.add(s);
     // The error is that of the rendered image; the time, that of the method on these pixels

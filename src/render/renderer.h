@@ -11,6 +11,7 @@
 #include <functional>
 #include <vector>
 
+#include "core/progress.h"
 #include "io/image.h"
 #include "lightcuts/evaluator.h"
 #include "scene/scene.h"
@@ -41,6 +42,9 @@ struct RenderOptions {
   std::atomic<bool>* cancel = nullptr;
   // Called from one thread with the fraction done (0..1), about ten times a second.
   std::function<void(double)> progress;
+  // The same for the brute-force reference pixels (core/progress.h), called from any
+  // worker thread, one at a time.
+  ProgressFn referenceProgress = {};
 };
 
 struct ReferenceStats {
