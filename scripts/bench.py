@@ -67,6 +67,9 @@ ROWS = [
     dict(key="cornell_water", name="Cornell water", scene="scenes/cornell_water.ray", gi=True),
     dict(key="church", name="Church", scene="scenes/church.ray", gi=True),
     dict(key="roman_hall", name="Roman hall", scene="scenes/roman_hall.ray", gi=True),
+    # Occlusion-heavy scenes (issue 20): most lights are hidden from most points.
+    dict(key="rooms", name="Rooms", scene="scenes/rooms.ray", gi=True),
+    dict(key="column_hall", name="Column hall", scene="scenes/column_hall.ray", gi=True),
 ]
 
 # One sentence per with/without-GI pair, written after looking at the images.
@@ -83,6 +86,13 @@ GI_DESCRIPTIONS = {
     "roman_hall": "Without GI the coffers, the walls above the cornice and the far end stay a dim brown under the "
                   "oculi and the lamps; with GI the vault, the walls and the floor brighten to a warm ochre, the "
                   "coffers' sides lit by light bounced from the floor.",
+    "rooms": "Without GI the ceiling around the camera room's dim warm panel, the upper corners and the underside "
+             "of the table are black, and the rooms beyond show only what their own coloured panels see; with GI "
+             "the ceiling and walls fill in and the floor by the left doorway warms with red light bounced from "
+             "the room beyond.",
+    "column_hall": "Without GI the ceiling between the beams, the beams' sides and the columns' far sides are "
+                   "near black and each lamp leaves sharp column shadows on the floor; with GI the ceiling and "
+                   "beams light up warm from the floor and the columns' shadowed sides fill in.",
 }
 
 SCALING_N = [1000, 10000, 100000, 1000000]
