@@ -378,7 +378,14 @@ void addRenderCommand(CLI::App& app) {
       ->check(CLI::Range(0, 1 << 24));
   c->add_option("--tonemap", a->tonemap, "8-bit output: clamp (the course renderer's) or srgb")
       ->check(CLI::IsMember({"clamp", "srgb"}));
-  c->add_option("--seed", a->seed, "Random seed (sampling, representatives, VPLs)");
+  // The VPLs are shot while the scene loads: an explicit --seed goes there too, over the
+  // scene's instant_radiosity seed.
+  auto setSeed = [a](const uint64_t& v) {
+    a->seed = v;
+    a->load.vplSeed = v;
+  };
+  c->add_option_function<uint64_t>("--seed", setSeed,
+                                   "Random seed (sampling, representatives, VPL paths; overrides instant_radiosity's seed); default 1");
   addSceneOptions(*c, a->load);
   c->callback([a] { exitStatus() = runRender(*a); });
 }

@@ -60,7 +60,7 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
     if (o.bounces) v.bounces = *o.bounces;
     if (o.vplNormalize) v.normalize = lights::parseVplNormalize(*o.vplNormalize);
     if (o.vplClamp) v.clamp = *o.vplClamp;
-    if (o.vplSeed != 1 || !(ir && ir->seed)) v.seed = o.vplSeed;
+    if (o.vplSeed) v.seed = *o.vplSeed;
     v.maxVpls = o.limits.maxVpls;
     if (v.count > 0) {
       ProgressBar bar("VPLs", o.quiet);

@@ -23,7 +23,9 @@ struct LoadOptions {
   std::optional<int> vplCount, bounces;
   std::optional<std::string> vplNormalize;
   std::optional<float> vplClamp;
-  uint64_t vplSeed = 1;
+  // render --seed: overrides the scene's instant_radiosity seed when given; unset, the scene's
+  // seed or VplOptions' default stands.
+  std::optional<uint64_t> vplSeed;
   bool gi = true;             // --gi off ignores instant_radiosity and --vpls
   // Linearise sRGB-marked (MTL) textures: scene::BuildOptions::linearizeSrgbTextures.
   bool linearizeSrgbTextures = false;

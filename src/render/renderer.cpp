@@ -59,11 +59,13 @@ class ShadowRays final : public lightcuts::Visibility {
   }
 
  private:
-  // The ray's origin, off the surface on the light's side, and its length to just short
-  // of the light.
+  // The ray's origin, off the surface on the light's side and a step toward the light,
+  // and its length to just short of the light. The step matters on an edge where two
+  // surfaces meet (a room's corner): the point lies in the other surface's plane, and
+  // watertight hits (issue 29) would count that surface at t = 0 and shadow the edge.
   Vec3 origin(const Vec3& wi, float dist, float& tmax) const {
-    tmax = std::isinf(dist) ? kInf : dist - 2 * eps_;
-    return p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_);
+    tmax = std::isinf(dist) ? kInf : dist - 3 * eps_;
+    return p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_) + wi * eps_;
   }
 
   const Scene& scene_;

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "io/ray_parser.h"
 
 namespace lc::render {
@@ -172,6 +175,43 @@ sphere { material = { transmissive = (0.9, 0.9, 0.9); reflective = (0.1, 0.1, 0.
   }
   // The centre sees the background through the sphere, dimmed by kt twice.
   EXPECT_NEAR(r.image.at(16, 16).z, 0.7f * 0.81f, 0.02f);
+}
+
+// Issue 29: a room of polymesh walls (two triangles per quad) seen head-on from its centre,
+// lit by a point light there without falloff. Pixel centres on the image diagonals hit the
+// quads' shared diagonals and the room's corner edges; every pixel is kd * cos of the angle
+// between the wall's normal and the view ray (the light sits at the eye), none black.
+TEST(Shading, HeadOnRoomOfQuadWallsIsLitEverywhere) {
+  for (const char* fov : {"90", "120"}) {
+  auto s = sceneFrom(std::string(R"(SBT-raytracer 1.0
+camera { position = (0, 0, 0); viewdir = (0, 0, 1); updir = (0, 1, 0); fov = )") + fov + R"(; }
+point_light { position = (0, 0, 0); colour = (1, 1, 1);
+  constant_attenuation_coeff = 1; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 0; }
+material = { diffuse = (0.5, 0.6, 0.7); specular = (0, 0, 0); }
+polymesh { points = ((-2.5,-2.5,-2.5), (2.5,-2.5,-2.5), (-2.5,2.5,-2.5), (2.5,2.5,-2.5),
+                     (-2.5,-2.5,2.5), (2.5,-2.5,2.5), (-2.5,2.5,2.5), (2.5,2.5,2.5));
+  faces = ((0,1,3,2), (4,6,7,5), (0,4,5,1), (2,3,7,6), (0,2,6,4), (1,5,7,3)); }
+)");
+  const Color kd(0.5f, 0.6f, 0.7f);
+  const scene::Camera& cam = s->camera();
+  for (int res : {255, 256}) {
+    RenderResult r = renderBrute(*s, res, res);
+    int bad = 0;
+    for (int y = 0; y < res; ++y)
+      for (int x = 0; x < res; ++x) {
+        Vec3 d = normalize(cam.direction((float(x) + 0.5f) / float(res), (float(y) + 0.5f) / float(res)));
+        // The wall hit is the one across the ray's largest component.
+        float cosine = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+        const Color& got = r.image.at(x, y);
+        bool ok = true;
+        for (int c = 0; c < 3; ++c) ok &= std::fabs(got[c] - kd[c] * cosine) < 1e-4f;
+        if (!ok && ++bad <= 5)
+          ADD_FAILURE() << "fov " << fov << ", " << res << "px: pixel " << x << "," << y << " is " << got[0] << " " << got[1] << " " << got[2]
+                        << ", expected " << kd[0] * cosine;
+      }
+    EXPECT_EQ(bad, 0) << "fov " << fov << ", " << res << "px";
+  }
+  }
 }
 
 TEST(Determinism, SameImageAtOneAndTwoThreads) {

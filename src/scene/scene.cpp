@@ -268,6 +268,10 @@ void Scene::buildGeometry(const BuildOptions& options) {
   rtcSetDeviceErrorFunction(device_, embreeErrorFunc, nullptr);
   rtc_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(rtc_, RTC_BUILD_QUALITY_HIGH);
+  // Watertight triangle tests (issue 29): in the default mode a ray through an edge shared
+  // by two triangles can miss both, which showed as black pixels along the diagonals of
+  // quads seen head-on and would let shadow rays through closed meshes.
+  rtcSetSceneFlags(rtc_, RTC_SCENE_FLAG_ROBUST);
   convex_.resize(shapes_.size());
   transmissive_.resize(shapes_.size());
   for (size_t i = 0; i < shapes_.size(); ++i) {
@@ -456,7 +460,11 @@ ShadingMaterial Scene::shadingMaterial(const Hit& hit) const {
 }
 
 Vec3 Scene::offsetOrigin(const Hit& hit, const Vec3& dir) const {
-  return hit.p + hit.ng * (dot(dir, hit.ng) >= 0 ? epsilon_ : -epsilon_);
+  // Off the surface and a step along the ray: from an edge where two surfaces meet, the
+  // other surface's plane passes through the hit, and watertight hits would find it at t = 0.
+  float len = length(dir);
+  Vec3 along = len > 0 ? dir * (epsilon_ / len) : Vec3(0, 0, 0);
+  return hit.p + hit.ng * (dot(dir, hit.ng) >= 0 ? epsilon_ : -epsilon_) + along;
 }
 
 }  // namespace lc::scene

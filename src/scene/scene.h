@@ -74,7 +74,8 @@ class Scene {
   // Material values at a hit (textures looked up, per-vertex materials blended).
   ShadingMaterial shadingMaterial(const Hit& hit) const;
 
-  // A point slightly off the surface on the side `dir` points to, for secondary rays.
+  // A point slightly off the surface on the side `dir` points to and slightly along `dir`,
+  // for secondary rays.
   Vec3 offsetOrigin(const Hit& hit, const Vec3& dir) const;
   float epsilon() const { return epsilon_; }
 

@@ -42,12 +42,18 @@ bool solveQuadratic(double a, double b, double c, double& t0, double& t1) {
   return true;
 }
 
+// Watertight rims (issue 29): the side and a cap of a cylinder or cone are separate tests,
+// and a ray through the rim itself could fail both by a rounding error each (z just above
+// the side's end, x^2 + y^2 just outside the disk) and pass between them. Both parts reach
+// this far past the rim, far above double rounding and far below anything visible.
+constexpr double kRimSlack = 1e-9;
+
 // A disk of radius r in the plane z = z0.
 void offerDisk(Closest& c, const double o[3], const double d[3], double z0, double r, int part) {
   if (d[2] == 0 || r <= 0) return;
   double t = (z0 - o[2]) / d[2];
   double x = o[0] + t * d[0], y = o[1] + t * d[1];
-  if (x * x + y * y <= r * r) c.offer(t, part);
+  if (x * x + y * y <= r * r * (1 + kRimSlack)) c.offer(t, part);
 }
 
 }  // namespace
@@ -108,7 +114,7 @@ bool intersectQuadric(const Shape& s, const Vec3& of, const Vec3& df, float tmin
       if (a > 0 && solveQuadratic(a, b, cc, t0, t1)) {
         for (double t : {t0, t1}) {
           double z = o[2] + t * d[2];
-          if (z >= 0 && z <= 1) c.offer(t, 0);
+          if (z >= -kRimSlack && z <= 1 + kRimSlack) c.offer(t, 0);
         }
       }
       if (s.capped) {
@@ -130,8 +136,11 @@ bool intersectQuadric(const Shape& s, const Vec3& of, const Vec3& df, float tmin
       if (solveQuadratic(a, b, cc, t0, t1)) {
         for (double t : {t0, t1}) {
           double z = o[2] + t * d[2];
-          // The quadric is a double cone: keep the nappe where the radius is non-negative.
-          if (z >= 0 && z <= h && r0 + k * z >= 0) c.offer(t, 0);
+          // The quadric is a double cone: keep the nappe where the radius is non-negative
+          // (the nappes meet at the apex, where the slack makes no difference).
+          double slack = kRimSlack * h;
+          if (z >= -slack && z <= h + slack && r0 + k * z >= -kRimSlack * std::max(std::fabs(r0), std::fabs(r1)))
+            c.offer(t, 0);
         }
       }
       if (s.capped) {
