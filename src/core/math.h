@@ -78,6 +78,29 @@ inline bool isFinite(const Vec3& v) {
 }
 constexpr Vec3 lerp(float t, const Vec3& a, const Vec3& b) { return a * (1 - t) + b * t; }
 
+// A double-precision vector for sums that run over many terms: light intensities summed up a
+// tree, brute force over every light, weighted means over millions of lights. A float sum
+// of N similar terms drops each term's bits below the running sum's ulp; at 8.1M lights
+// (the Cornell box at --vpls 10000000) a brute-force pixel lost up to 8% of its light that
+// way. Values are stored back in float (Vec3) once summed.
+struct Vec3d {
+  double x = 0, y = 0, z = 0;
+  constexpr Vec3d() = default;
+  constexpr Vec3d(double x_, double y_, double z_) : x(x_), y(y_), z(z_) {}
+  constexpr explicit Vec3d(const Vec3& v) : x(v.x), y(v.y), z(v.z) {}
+
+  constexpr Vec3d operator+(const Vec3d& o) const { return {x + o.x, y + o.y, z + o.z}; }
+  constexpr Vec3d operator-(const Vec3d& o) const { return {x - o.x, y - o.y, z - o.z}; }
+  constexpr Vec3d operator*(double s) const { return {x * s, y * s, z * s}; }
+  constexpr Vec3d operator/(double s) const { return {x / s, y / s, z / s}; }
+  constexpr Vec3d& operator+=(const Vec3d& o) { x += o.x; y += o.y; z += o.z; return *this; }
+  constexpr Vec3d& operator+=(const Vec3& o) { x += o.x; y += o.y; z += o.z; return *this; }
+  constexpr Vec3d& operator-=(const Vec3& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
+  // Rounded to float, each component once.
+  constexpr Vec3 toFloat() const { return {float(x), float(y), float(z)}; }
+};
+constexpr double luminance(const Vec3d& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
 // Reflect v about n (both pointing away from the surface): r = 2(n.v)n - v.
 constexpr Vec3 reflect(const Vec3& v, const Vec3& n) { return n * (2 * dot(n, v)) - v; }
 

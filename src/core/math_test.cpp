@@ -94,3 +94,20 @@ TEST(PowNonNegative, MatchesStdPowAndIsMonotone) {
 }
 
 }  // namespace lc
+
+namespace lc {
+namespace {
+
+// Ten million terms of 0.1 (not a float): the double sum is exact to 1e-9, a float one
+// would be off by percents.
+TEST(Vec3d, SumsMillionsOfFloatsExactly) {
+  Vec3d s;
+  const Vec3 t(0.1f, 0.2f, 0.3f);
+  for (int i = 0; i < 10'000'000; ++i) s += t;
+  const Vec3 v = s.toFloat();
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(v[k], 1e7 * double(t[k]), 1e-6 * 1e7 * double(t[k]));
+  EXPECT_NEAR(luminance(s), 1e7 * double(luminance(t)), 1e-6 * 1e7 * double(luminance(t)));
+}
+
+}  // namespace
+}  // namespace lc

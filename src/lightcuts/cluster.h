@@ -18,7 +18,12 @@ struct Cluster {
   float cosHalfAngle = 1;
   float halfAngle = 0;  // acos(cosHalfAngle), cached for the metric
   float weight = 0;     // luminance of the summed intensity: the metric's I
-  Color intensity;
+  // Summed RGB intensity, in double: a tree's merges may form long chains (a bright light
+  // absorbing millions of dim ones one by one), and a float sum along a chain loses the dim
+  // ones. Stored in the node as float once summed. (`weight` stays a float sum: it steers
+  // the metric and the representative's choice, where 1e-7 per merge is immaterial, and it
+  // keeps the trees of earlier releases bit for bit.)
+  Vec3d intensity;
   uint32_t rep = 0;
   int32_t left = -1, right = -1;
 };
@@ -36,7 +41,7 @@ inline Cluster leafCluster(const Light& l, uint32_t index) {
   c.axis = hasCone ? l.direction : Vec3(0, 0, 1);
   c.cosHalfAngle = hasCone ? 1.0f : -1.0f;
   c.halfAngle = hasCone ? 0.0f : kPi;
-  c.intensity = l.intensity;
+  c.intensity = Vec3d(l.intensity);
   c.weight = luminance(l.intensity);
   c.rep = index;
   return c;
@@ -75,7 +80,7 @@ inline void setNodeFromCluster(LightNode& n, const Cluster& c) {
   n.axis = c.axis;
   n.cosHalfAngle = c.cosHalfAngle;
   n.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - c.cosHalfAngle * c.cosHalfAngle));
-  n.intensity = c.intensity;
+  n.intensity = c.intensity.toFloat();
   n.rep = c.rep;
   n.left = 0;
 }

@@ -99,13 +99,16 @@ class BruteForce final : public LightEvaluator {
  public:
   explicit BruteForce(const LightSet& lights) : lights_(lights) {}
   EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const override {
-    Color sum(0);
+    // Summed in double: over millions of lights a float sum drops the small terms (each
+    // below half an ulp of the running sum is lost); at 8.1M VPLs behind a 256-light panel
+    // brute force came out up to 8% low.
+    Vec3d sum;
     ShadowResult res;
     for (const Light& l : lights_.lights)
       sum += shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, res) * l.intensity;
     uint32_t n = uint32_t(lights_.lights.size());
     stats.recordCut(n);
-    return {sum, n};
+    return {sum.toFloat(), n};
   }
   Method method() const override { return Method::Brute; }
 
@@ -214,7 +217,9 @@ class Lightcuts final : public LightEvaluator {
     heap.clear();
     nodes.clear();
     BoundFrames frames(sp);
-    Color total(0);
+    // The cut's estimate, in double: refinement subtracts a node's estimate and adds its
+    // children's thousands of times, and the stopping rule compares against it.
+    Vec3d total;
     uint32_t cutSize = 0;
     // Sums of the squared spreads of the nodes in the heap: those scaled by the boundary
     // rate, and the others.
@@ -286,7 +291,7 @@ class Lightcuts final : public LightEvaluator {
     const double rssFactor2 = kTotalFactor * kTotalFactor;
     while (!heap.empty()) {
       if (cutSize >= uint32_t(opt_.maxCut)) break;
-      float limit = eps * luminance(total);
+      float limit = float(eps * luminance(total));
       const uint64_t top = heap.front();
       if (keyBound(top) <= limit) {
         if (!rss) break;
@@ -346,7 +351,8 @@ class Lightcuts final : public LightEvaluator {
         if (raw > 0 && lf > 0) {
           float kept = std::clamp(lf, cn.lower, cn.upper);
           fo *= kept / lf;
-          total += fo - cn.estimate;
+          total += fo;
+          total -= cn.estimate;
           factor = std::clamp(kept / raw, 0.5f, 2.0f);
         }
       }
@@ -371,7 +377,7 @@ class Lightcuts final : public LightEvaluator {
         record->treeBegin[t] = std::min(record->treeBegin[t], record->treeBegin[t + 1]);
     }
     stats.recordCut(cutSize);
-    return {vmax(total, Color(0)), cutSize};
+    return {vmax(total.toFloat(), Color(0)), cutSize};
   }
   Method method() const override { return Method::Lightcuts; }
 

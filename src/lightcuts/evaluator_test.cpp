@@ -311,3 +311,40 @@ TEST(VisibilityProbes, ProvenHiddenClustersAreExact) {
 
 }  // namespace
 }  // namespace lc::lightcuts
+
+namespace lc::lightcuts {
+namespace {
+
+// Brute force over a bright light and four million dim ones that together give as much
+// light (issue 21: a 256-light panel and 8.1M VPLs). All share one point and normal, so
+// the sum is (B + N t) f exactly, f one light's contribution per unit intensity. Summed in
+// float, each dim term fell below half an ulp of the running sum and was lost.
+TEST(Precision, BruteForceOverMillionsOfDimLightsIsExact) {
+  constexpr uint32_t kDim = 4'000'000;
+  LightSet s;
+  s.groups.push_back(LightGroup{});
+  Light l;
+  l.type = LightType::Oriented;
+  l.position = Vec3(0.5f, 3, -0.25f);
+  l.direction = Vec3(0, -1, 0);
+  const Color bright(1.0f, 0.5f, 0.25f), dim = bright / float(kDim);
+  l.intensity = bright;
+  s.lights.assign(kDim + 1, l);
+  for (uint32_t i = 1; i <= kDim; ++i) s.lights[i].intensity = dim;
+  ShadingPoint sp = point(Vec3(0, 0, 0));
+  Color unit;
+  Vec3 wi;
+  float dist;
+  ASSERT_TRUE(lightContribution(l, s.groups[0], sp, unit, wi, dist));
+  Unoccluded vis;
+  EvalStats st;
+  EvalResult r = makeBruteForce(s)->evaluate(sp, vis, st);
+  for (int k = 0; k < 3; ++k) {
+    const double want = double(unit[k]) * (double(bright[k]) + double(kDim) * double(dim[k]));
+    EXPECT_NEAR(r.radiance[k], want, 1e-6 * want) << "channel " << k;
+  }
+  EXPECT_EQ(r.cutSize, kDim + 1);
+}
+
+}  // namespace
+}  // namespace lc::lightcuts

@@ -90,26 +90,62 @@ struct GroupKey {
 }  // namespace
 
 void computeMoments(const LightSet& lights, LightTree& tree) {
-  // Bottom-up: children always have larger indices than their parent in our layout, so a
-  // reverse sweep visits children first.
+  // The luminance-weighted sums of each subtree's positions and axes, in double, divided
+  // once per node: a node's mean is exact to float rounding however many lights it holds
+  // and however deep (a mean of the children's float means loses ~1e-7 per level, which a
+  // long chain of merges adds up). Post-order walk with an explicit stack: memory in the
+  // tree's depth, not its size. A subtree of zero weight takes the plain mean.
+  struct Sums {
+    double w = 0, n = 0;
+    Vec3d pos, axis;    // sum of w x, sum of w n
+    Vec3d posU, axisU;  // unweighted sums
+  };
   std::vector<NodeMoments>& m = tree.moments;
   m.assign(tree.nodes.size(), NodeMoments{});
-  for (size_t i = tree.nodes.size(); i-- > 0;) {
+  if (tree.nodes.empty()) return;
+  std::vector<std::pair<uint32_t, bool>> stack{{0u, false}};  // node, children done
+  std::vector<Sums> done;  // the finished subtrees whose parent is not
+  while (!stack.empty()) {
+    auto [i, expanded] = stack.back();
+    stack.pop_back();
     const LightNode& n = tree.nodes[i];
     if (n.isLeaf()) {
       const Light& l = lights.lights[n.rep];
       m[i].centroid = l.type == LightType::Directional ? -l.direction : l.position;
       m[i].meanAxis = l.direction;
+      Sums s;
+      s.w = luminance(n.intensity);
+      s.n = 1;
+      s.posU = Vec3d(m[i].centroid);
+      s.axisU = Vec3d(m[i].meanAxis);
+      s.pos = s.posU * s.w;
+      s.axis = s.axisU * s.w;
+      done.push_back(s);
       continue;
     }
-    float wa = luminance(tree.nodes[n.left].intensity), wb = luminance(tree.nodes[n.left + 1].intensity);
-    float w = wa + wb;
-    if (!(w > 0)) { wa = wb = 0.5f; w = 1; }
-    const NodeMoments& a = m[n.left];
-    const NodeMoments& b = m[n.left + 1];
-    m[i].centroid = (a.centroid * wa + b.centroid * wb) / w;
-    m[i].meanAxis = (a.meanAxis * wa + b.meanAxis * wb) / w;
-    m[i].lights = a.lights + b.lights;
+    if (!expanded) {
+      stack.emplace_back(i, true);
+      stack.emplace_back(n.left + 1, false);
+      stack.emplace_back(n.left, false);
+      continue;
+    }
+    Sums b = done.back();
+    done.pop_back();
+    Sums& s = done.back();  // the left child's, becomes this node's
+    s.w += b.w;
+    s.n += b.n;
+    s.pos += b.pos;
+    s.axis += b.axis;
+    s.posU += b.posU;
+    s.axisU += b.axisU;
+    if (s.w > 0) {
+      m[i].centroid = (s.pos / s.w).toFloat();
+      m[i].meanAxis = (s.axis / s.w).toFloat();
+    } else {
+      m[i].centroid = (s.posU / s.n).toFloat();
+      m[i].meanAxis = (s.axisU / s.n).toFloat();
+    }
+    m[i].lights = m[n.left].lights + m[n.left + 1].lights;
   }
 }
 

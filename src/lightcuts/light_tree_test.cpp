@@ -1,4 +1,5 @@
 #include "lightcuts/light_tree.h"
+#include "lightcuts/bounds.h"
 #include "lightcuts/test_lights.h"
 
 #include <gtest/gtest.h>
@@ -201,6 +202,100 @@ TEST(SeedBuild, ErrorIsWeightedMeanDistanceToCentroid) {
 }
 
 TEST(Nodes, AreCompact) { EXPECT_LE(sizeof(LightNode), 64u); }
+
+// ---- precision over millions of lights (issue 21: 8.1M VPLs) ----
+
+// A bright light that absorbs ten million dim ones, one merge at a time: the longest chain
+// a tree can have. All sit at one point with one normal, so the cluster's light at any
+// receiver is exactly (B + N t) f, f one light's contribution per unit intensity. A float
+// sum along the chain never grows: each t is below half an ulp of it (it came out 1
+// instead of 1.3 here); summed in double, the node's intensity, its estimate and its bounds
+// hold to float rounding.
+TEST(Precision, ChainOfTenMillionMergesKeepsTheClusterIntensity) {
+  constexpr uint32_t kDim = 10'000'000;
+  const Color bright(1.0f, 0.5f, 0.25f), dim = bright * 3e-8f;
+  Light l;
+  l.type = LightType::Oriented;
+  l.position = Vec3(0.5f, 3, -0.25f);
+  l.direction = Vec3(0, -1, 0);
+  l.intensity = bright;
+  detail::Cluster c = detail::leafCluster(l, 0);
+  l.intensity = dim;
+  for (uint32_t i = 1; i <= kDim; ++i)
+    c = detail::mergeClusters(c, detail::leafCluster(l, i), int32_t(2 * i), int32_t(2 * i + 1), true, 7);
+  LightNode node{};
+  detail::setNodeFromCluster(node, c);
+  node.left = 1;  // an inner node
+  for (int k = 0; k < 3; ++k) {
+    const double want = double(bright[k]) + double(kDim) * double(dim[k]);
+    EXPECT_NEAR(node.intensity[k], want, 1e-6 * want) << "channel " << k;
+  }
+
+  LightGroup g;
+  ShadingPoint sp = test_lights::point(Vec3(0, 0, 0));
+  Color unit;
+  Vec3 wi;
+  float dist;
+  ASSERT_TRUE(lightContribution(l, g, sp, unit, wi, dist));
+  const double total = double(luminance(bright)) + double(kDim) * double(luminance(dim));
+  const double exact = double(luminance(unit)) * total;  // M G is one colour: luminance factors only
+  Color cm = unit * (bright + dim * float(kDim));        // closed form, per channel
+  EXPECT_NEAR(luminance(unit * node.intensity), luminance(cm), 1e-6 * exact) << "estimate";
+  Color lower;
+  Color upper = clusterBounds(node, LightType::Oriented, g, sp, BoundFrames(sp), &lower);
+  // The bounds carry a few 1e-4 of slack against rounding; the float sum lost 23%.
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_LE(lower[k], cm[k] * (1 + 1e-6f)) << "channel " << k;
+    EXPECT_GE(upper[k], cm[k] * (1 - 1e-6f)) << "channel " << k;
+    EXPECT_NEAR(upper[k], cm[k], 5e-4f * cm[k]) << "channel " << k;
+    EXPECT_NEAR(lower[k], cm[k], 5e-4f * cm[k]) << "channel " << k;
+  }
+}
+
+// Node moments of a caterpillar tree (each inner node: one leaf and the rest) over a
+// million lights at x = i / N, all alike: every node's centroid is the mean of its suffix,
+// (i0 + N - 1) / (2N), in closed form. Means of the children's float means lose ~1e-7 per
+// level, and here there are a million levels.
+TEST(Precision, MomentsOfAMillionLevelChainAreExact) {
+  constexpr uint32_t kN = 1'000'000;
+  LightSet s;
+  s.groups.push_back(LightGroup{});
+  s.lights.resize(kN);
+  for (uint32_t i = 0; i < kN; ++i) {
+    s.lights[i].type = LightType::Omni;
+    s.lights[i].position = Vec3(float(i) / float(kN), 1, 0);
+    s.lights[i].direction = Vec3(0, 0, 1);
+    s.lights[i].intensity = Color(0.3f);
+  }
+  // Node 2j (j < N-1) is inner: left child 2j+1 is light j's leaf, right child 2j+2 the rest.
+  LightTree t;
+  t.type = LightType::Omni;
+  t.nodes.resize(2 * size_t(kN) - 1);
+  for (uint32_t j = 0; j < kN; ++j) {
+    LightNode& leaf = t.nodes[j + 1 < kN ? 2 * j + 1 : 2 * j];
+    leaf = LightNode{};
+    leaf.lo = leaf.hi = s.lights[j].position;
+    leaf.intensity = s.lights[j].intensity;
+    leaf.rep = j;
+    leaf.left = 0;
+  }
+  for (uint32_t j = kN - 1; j-- > 0;) {
+    LightNode& n = t.nodes[2 * j];
+    n = LightNode{};
+    n.lo = Vec3(float(j) / float(kN), 1, 0);
+    n.hi = Vec3(float(kN - 1) / float(kN), 1, 0);
+    n.intensity = Color(float(0.3 * double(kN - j)));
+    n.rep = j;
+    n.left = 2 * j + 1;
+  }
+  computeMoments(s, t);
+  for (uint32_t j : {0u, 1u, 1000u, kN / 2, kN - 10}) {
+    const NodeMoments& m = t.moments[2 * j];
+    const double want = (double(j) + double(kN - 1)) / (2.0 * kN);
+    EXPECT_NEAR(m.centroid.x, want, 1e-6 * want) << "node of the suffix from light " << j;
+    EXPECT_EQ(m.lights, kN - j);
+  }
+}
 
 }  // namespace
 }  // namespace lc::lightcuts

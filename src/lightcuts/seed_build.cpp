@@ -55,13 +55,13 @@ struct SeedBuilder {
       float extent = point(sorted.back())[axis] - point(sorted.front())[axis];
       if (!(extent > 0)) continue;
       float meanGap = extent / float(n - 1);
-      float colourSum = 0;
+      double colourSum = 0;  // over up to millions of lights: in double
       for (size_t k = 1; k < n; ++k) {
         Vec3 d = vabs(chromaticity(lights.lights[sorted[k]].intensity) -
                       chromaticity(lights.lights[sorted[k - 1]].intensity));
         colourSum += d.x + d.y + d.z;
       }
-      float meanColour = colourSum / float(n - 1);
+      float meanColour = float(colourSum / double(n - 1));
       for (size_t k = kLo; k <= kHi; ++k) {
         float gap = point(sorted[k])[axis] - point(sorted[k - 1])[axis];
         Vec3 cd = vabs(chromaticity(lights.lights[sorted[k]].intensity) -
@@ -84,21 +84,21 @@ struct SeedBuilder {
   }
 
   // The seed's per-node error over idx[b, e), exactly.
+  // Sums in double: the root's run over every light.
   float nodeError(size_t b, size_t e) const {
-    float w = 0;
-    Vec3 centroid(0);
-    Color cSum(0);
+    double w = 0;
+    Vec3d centroidSum, cSum;
     for (size_t i = b; i < e; ++i) {
       const Light& l = lights.lights[idx[i]];
       float li = luminance(l.intensity);
       w += li;
-      centroid += point(idx[i]) * li;
+      centroidSum += Vec3d(point(idx[i])) * li;
       cSum += l.intensity;
     }
     if (!(w > 0)) return 0;
-    centroid /= w;
-    Color cm = chromaticity(cSum);
-    float dist = 0, spread = 0;
+    Vec3 centroid = (centroidSum / w).toFloat();
+    Color cm = chromaticity(cSum.toFloat());
+    double dist = 0, spread = 0;
     for (size_t i = b; i < e; ++i) {
       const Light& l = lights.lights[idx[i]];
       float li = luminance(l.intensity);
@@ -106,7 +106,7 @@ struct SeedBuilder {
       Vec3 d = vabs(chromaticity(l.intensity) - cm);
       spread += li * (d.x + d.y + d.z);
     }
-    return (dist / w) * (1 + spread / w);
+    return float((dist / w) * (1 + spread / w));
   }
 
   // Builds the subtree over idx[b, e) and returns its cluster index.

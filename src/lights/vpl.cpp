@@ -214,6 +214,7 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
   for (const Light& l : sources) sceneIntensity += l.intensity;
 
   set.lights.reserve(set.lights.size() + count);
+  Vec3d power;  // over millions of VPLs: in double
   for (const auto& d : out)
     for (const Deposit& v : d) {
       Light l;
@@ -223,10 +224,11 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
       l.direction = v.normal;
       Color I = o.normalize == VplNormalize::Object ? sceneIntensity * v.kd / float(perShape[size_t(v.shape)])
                                                     : v.flux / kPi;
-      info.power += o.normalize == VplNormalize::Object ? I * kPi : v.flux;
+      power += o.normalize == VplNormalize::Object ? I * kPi : v.flux;
       l.intensity = I * scale;
       set.lights.push_back(l);
     }
+  info.power = power.toFloat();
   info.paths = n;
   info.vpls = count;
   info.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -590,7 +590,11 @@ double vplClampedFraction(const Scene& scene, const RenderOptions& o, int points
       if (isBlack(v)) continue;
       double c = luminance(mg * v * l.intensity);
       // The clamp is min(1, 1/(q d^2)); without it the attenuation would be 1/(q d^2).
-      double free = g.atten.quadratic > 0 ? c / g.atten(dist) / (double(g.atten.quadratic) * dist * dist) : c;
+      // Where it does not clamp, the light is the same with or without it: counted as c
+      // itself (dividing out the float attenuation and multiplying the exact one back left
+      // a rounding of either sign, which summed to "removes -0.0%").
+      const double qd2 = double(g.atten.quadratic) * dist * dist;
+      double free = g.atten.quadratic > 0 && g.atten(dist) >= 1.0f && qd2 > 0 ? c / qd2 : c;
       clamped[i] += c;
       unclamped[i] += free;
     }
@@ -600,7 +604,7 @@ double vplClampedFraction(const Scene& scene, const RenderOptions& o, int points
     a += clamped[i];
     b += unclamped[i];
   }
-  return b > 0 ? 1 - a / b : 0;
+  return b > 0 ? std::max(0.0, 1 - a / b) : 0;
 }
 
 Color traceRay(const Scene& scene, const LightEvaluator& evaluator, const Ray& ray, int maxDepth,
