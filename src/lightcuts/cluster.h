@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/rng.h"
@@ -17,7 +18,8 @@ struct Cluster {
   Vec3 axis;
   float cosHalfAngle = 1;
   float halfAngle = 0;  // acos(cosHalfAngle), cached for the metric
-  float weight = 0;     // luminance of the summed intensity: the metric's I
+  float weight = 0;     // luminance of the summed intensity, relative to the brightest light:
+                        // the metric's I (normalised so that sums cannot overflow)
   Color intensity;
   uint32_t rep = 0;
   int32_t left = -1, right = -1;
@@ -37,7 +39,7 @@ inline Cluster leafCluster(const Light& l, uint32_t index) {
   c.cosHalfAngle = hasCone ? 1.0f : -1.0f;
   c.halfAngle = hasCone ? 0.0f : kPi;
   c.intensity = l.intensity;
-  c.weight = luminance(l.intensity);
+  c.weight = luminance(l.intensity);  // buildAgglomerativeTree normalises it
   c.rep = index;
   return c;
 }
@@ -58,7 +60,8 @@ inline Cluster mergeClusters(const Cluster& a, const Cluster& b, int32_t ia, int
     c.cosHalfAngle = -1;
     c.halfAngle = kPi;
   }
-  c.intensity = a.intensity + b.intensity;
+  // Clamped: lights of huge power (sums beyond FLT_MAX) keep finite node intensities.
+  c.intensity = vmin(a.intensity + b.intensity, Color(std::numeric_limits<float>::max()));
   c.weight = a.weight + b.weight;
   uint64_t h = splitmix64(seed ^ (uint64_t(uint32_t(ia)) << 32 | uint32_t(ib)));
   double u = double(h >> 11) * 0x1p-53;
