@@ -381,6 +381,12 @@ std::vector<Row> catalogue() {
                      {"--max-nesting", "2"}));
   rows.push_back(ray("limit_image_pixels", "sphere {}", "an image of 100x100 exceeds --max-image-pixels (1000)",
                      {"--width", "100", "--height", "100", "--max-image-pixels", "1000"}));
+  rows.push_back(ray("aspect_ratio_too_wide", "camera { aspectratio = 3e9; }",
+                     "aspectratio 3000000000 makes the image 3000000000x1: more than 65536 pixels wide (give both --width and --height)",
+                     {"--height", "1"}));
+  rows.push_back(ray("aspect_ratio_too_high", "camera { aspectratio = 0.0001; }",
+                     "aspectratio 0.0001 makes the image 10x100000: more than 65536 pixels high (give both --width and --height)",
+                     {"--width", "10"}));
   rows.push_back(ray("limit_objects", "sphere {} sphere {} sphere {}",
                      "limit_objects.ray:2:21: error: more objects and materials than the limit of 3 (raise it with --max-objects)",
                      {"--max-objects", "3"}));
@@ -434,6 +440,28 @@ TEST(CliUsage, OutOfRangeOptionIsAUsageError) {
   EXPECT_EQ(r.status, 105);
   EXPECT_NE(r.err.find("--width: Value 0 not in range 1 to 65536"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir.file("out.png")));
+}
+
+// Issue 23: limits take whole numbers >= 0; -1 used to wrap around to no limit at all
+// (--max-lights, --max-image-pixels) or to read "a limit of -1 levels" (--max-nesting).
+TEST(CliUsage, NegativeLimitsAreUsageErrors) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + "point_light {} sphere {}");
+  for (const char* flag : {"--max-lights", "--max-vpls", "--max-triangles", "--max-nesting", "--max-objects",
+                           "--max-image-pixels", "--max-texture-pixels"}) {
+    for (const char* value : {"-1", "1.5", "x"}) {
+      CliResult r = run({"render", "s.ray", "-o", "out.png", "-q", flag, value}, dir.path());
+      EXPECT_EQ(r.status, 105) << flag << " " << value << ": " << r.err;
+      EXPECT_NE(r.err.find(std::string(flag) + ": a limit must be a whole number >= 0 (0 allows none), got " + value),
+                std::string::npos)
+          << r.err;
+      EXPECT_FALSE(fs::exists(dir.file("out.png")));
+    }
+  }
+  // 0 is a limit like any other: it allows none.
+  CliResult r = run({"info", "s.ray", "--max-lights", "0"}, dir.path());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("more lights than the limit of 0"), std::string::npos) << r.err;
 }
 
 // A valid scene renders: status 0 and the file exists (the baseline for the rows above).
