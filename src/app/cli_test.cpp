@@ -367,6 +367,35 @@ std::vector<Row> catalogue() {
                 {"--stats", "missing/stats.json"});
     rows.push_back(r);
   }
+  // ---- colliding paths (issue 23: the later write used to win, or the input was overwritten)
+  rows.push_back(ray("stats_is_the_image", "sphere {}",
+                     "'out.png' is given as both -o and --stats; use different files",
+                     {"--stats", "out.png"}));
+  rows.push_back(ray("heatmap_is_the_image", "sphere {}",
+                     "'./out.png' (--cut-heatmap) is the same file as 'out.png' (-o); use different files",
+                     {"--cut-heatmap", "./out.png"}));
+  {
+    Row r = ray("output_is_the_scene", "sphere {}",
+                "'output_is_the_scene.ray' is given as both the scene and -o; use different files");
+    r.args = {"render", "output_is_the_scene.ray", "-o", "output_is_the_scene.ray", "-q"};
+    rows.push_back(r);
+  }
+  {
+    Row r;
+    r.name = "obj2ray_overwrites_input";
+    r.files = {{"in.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"}};
+    r.args = {"obj2ray", "in.obj", "-o", "in.obj"};
+    r.message = "'in.obj' is given as both the input OBJ and -o; use different files";
+    rows.push_back(r);
+  }
+  {
+    Row r;
+    r.name = "heatmap_overwrites_reference";
+    r.files = {{"a.ppm", "P6\n1 1\n255\nabc"}, {"b.ppm", "P6\n1 1\n255\nabc"}};
+    r.args = {"compare", "a.ppm", "b.ppm", "--heatmap", "a.ppm"};
+    r.message = "'a.ppm' is given as both the reference image and --heatmap; use different files";
+    rows.push_back(r);
+  }
   // ---- limits (the tests in CliLimits below cover each flag in more detail)
   rows.push_back(ray("limit_triangles",
                      "trimesh { points = ((0,0,0),(1,0,0),(0,1,0),(1,1,0)); "

@@ -99,6 +99,7 @@ std::string defaultOutput(const std::string& scene) {
 int runRender(RenderArgs& a) {
   auto t0 = std::chrono::steady_clock::now();
   if (a.out.empty()) a.out = defaultOutput(a.scene);
+  checkDistinctPaths({{a.scene, "the scene"}, {a.out, "-o"}, {a.stats, "--stats"}, {a.cutHeatmap, "--cut-heatmap"}});
   std::string ext = fileExtension(a.out);
   if (std::filesystem::is_directory(a.out)) throw Error("cannot write '" + a.out + "': it is a directory");
   if (ext.empty())

@@ -53,6 +53,34 @@ void writeFileAtomically(const std::string& path,
   }
 }
 
+namespace {
+std::string canonicalOrAbsolute(const std::string& p) {
+  std::error_code ec;
+  // Absolute first: for a path none of whose parts exist yet, weakly_canonical returns it
+  // as given ("out.png" vs "./out.png"); lexically_normal removes what is left of "." parts.
+  fs::path abs = fs::absolute(fs::path(p), ec);
+  if (ec) abs = fs::path(p);
+  fs::path c = fs::weakly_canonical(abs, ec);
+  if (ec) c = abs;
+  return c.lexically_normal().string();
+}
+}  // namespace
+
+void checkDistinctPaths(const std::vector<NamedPath>& paths) {
+  std::vector<std::string> canon(paths.size());
+  for (size_t i = 0; i < paths.size(); ++i)
+    if (!paths[i].path.empty()) canon[i] = canonicalOrAbsolute(paths[i].path);
+  for (size_t j = 0; j < paths.size(); ++j)
+    for (size_t i = 0; i < j; ++i) {
+      if (paths[i].path.empty() || paths[j].path.empty() || canon[i] != canon[j]) continue;
+      const NamedPath &a = paths[i], &b = paths[j];
+      if (a.path == b.path)
+        throw Error("'" + a.path + "' is given as both " + a.role + " and " + b.role + "; use different files");
+      throw Error("'" + b.path + "' (" + b.role + ") is the same file as '" + a.path + "' (" + a.role +
+                  "); use different files");
+    }
+}
+
 void checkWritable(const std::string& path) {
   if (path.empty()) throw Error("empty output path");
   std::error_code ec;
