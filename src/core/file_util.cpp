@@ -19,12 +19,12 @@ namespace lc {
 
 std::string readFile(const std::string& path) {
   std::error_code ec;
-  if (fs::is_directory(path, ec)) throw Error("cannot read '" + path + "': it is a directory");
+  if (fs::is_directory(path, ec)) throw Error("cannot read " + quoteInput(path) + ": it is a directory");
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open '" + path + "': " + std::strerror(errno));
+  if (!in) throw Error("cannot open " + quoteInput(path) + ": " + std::strerror(errno));
   std::ostringstream ss;
   ss << in.rdbuf();
-  if (in.bad()) throw Error("cannot read '" + path + "'");
+  if (in.bad()) throw Error("cannot read " + quoteInput(path) + "");
   return ss.str();
 }
 
@@ -40,13 +40,13 @@ void writeFileAtomically(const std::string& path,
     write(tmp);
     // Flush to disk before the rename so a crash cannot leave an empty file behind.
     int fd = ::open(tmp.c_str(), O_RDONLY);
-    if (fd < 0) throw Error("cannot write '" + path + "': " + std::strerror(errno));
+    if (fd < 0) throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(errno));
     int syncErr = ::fsync(fd) == 0 ? 0 : errno;
     ::close(fd);
     if (syncErr != 0 && syncErr != EINVAL)
-      throw Error("cannot write '" + path + "': " + std::strerror(syncErr));
+      throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(syncErr));
     if (std::rename(tmp.c_str(), path.c_str()) != 0)
-      throw Error("cannot write '" + path + "': " + std::strerror(errno));
+      throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(errno));
   } catch (...) {
     std::remove(tmp.c_str());
     throw;
@@ -75,8 +75,8 @@ void checkDistinctPaths(const std::vector<NamedPath>& paths) {
       if (paths[i].path.empty() || paths[j].path.empty() || canon[i] != canon[j]) continue;
       const NamedPath &a = paths[i], &b = paths[j];
       if (a.path == b.path)
-        throw Error("'" + a.path + "' is given as both " + a.role + " and " + b.role + "; use different files");
-      throw Error("'" + b.path + "' (" + b.role + ") is the same file as '" + a.path + "' (" + a.role +
+        throw Error(quoteInput(a.path) + " is given as both " + a.role + " and " + b.role + "; use different files");
+      throw Error(quoteInput(b.path) + " (" + b.role + ") is the same file as " + quoteInput(a.path) + " (" + a.role +
                   "); use different files");
     }
 }
@@ -85,10 +85,10 @@ void checkWritable(const std::string& path) {
   if (path.empty()) throw Error("empty output path");
   std::error_code ec;
   if (fs::is_directory(path, ec))
-    throw Error("cannot write '" + path + "': it is a directory");
+    throw Error("cannot write " + quoteInput(path) + ": it is a directory");
   std::string tmp = tempNameFor(path);
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
-  if (fd < 0) throw Error("cannot write '" + path + "': " + std::strerror(errno));
+  if (fd < 0) throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(errno));
   ::close(fd);
   ::unlink(tmp.c_str());
 }

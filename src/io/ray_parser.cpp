@@ -355,7 +355,7 @@ void Parser::block(const std::string& what, F&& onAttr) {
 }
 
 void Parser::unknown(const Token& key, const std::string& context) {
-  std::string msg = "unknown keyword '" + key.text + "'";
+  std::string msg = "unknown keyword " + quoteInput(key.text) + "";
   if (!context.empty()) msg += " in " + context;
   if (!opt_.lenient) fail(key, msg);
   scene_.warnings.push_back(lex_.loc(key).str() + ": warning: " + msg + " (skipped)");
@@ -464,7 +464,7 @@ int Parser::materialValue(int baseIndex) {
   if (t.kind == TokenKind::Ident) {
     Token n = lex_.next();
     auto it = named_.find(n.text);
-    if (it == named_.end()) fail(n, "unknown material '" + n.text + "'");
+    if (it == named_.end()) fail(n, "unknown material " + quoteInput(n.text) + "");
     return it->second;
   }
   expected("a material block '{...}' or a material name", lex_.next());
@@ -518,7 +518,7 @@ int Parser::materialBlock(int baseIndex) {
       if (!n.empty()) {
         auto it = named_.find(n);
         if (it != named_.end())
-          fail(at, "material '" + n + "' is already declared (at " +
+          fail(at, "material " + quoteInput(n) + " is already declared (at " +
                        scene_.materials[size_t(it->second)].loc.str() + ")");
       }
       m.name = n;
@@ -1076,7 +1076,7 @@ void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
   std::vector<Pos> deferred;  // index positions when faces precede points
   bool pointsDone = false;
   auto once = [&](int i, const Token& k) {
-    if (seen[i]) fail(k, "'" + k.text + "' is given twice in " + kw.text);
+    if (seen[i]) fail(k, quoteInput(k.text) + " is given twice in " + kw.text);
     seen[i] = true;
     listTok[i] = k;
     expectEquals();
@@ -1224,7 +1224,7 @@ void Parser::objMesh(const Token& kw, ObjectDesc& obj) {
 SceneDesc parseRayString(const std::string& text, const std::string& name, const std::string& baseDir,
                          const ParseOptions& options) {
   if (text.size() > options.limits.maxFileBytes)
-    throw Error("'" + name + "' is larger than the limit of " + std::to_string(options.limits.maxFileBytes) +
+    throw Error(quoteInput(name) + " is larger than the limit of " + std::to_string(options.limits.maxFileBytes) +
                 " bytes");
   Parser parser(text, name, baseDir, options);
   return parser.run();
@@ -1234,7 +1234,7 @@ SceneDesc parseRayFile(const std::string& path, const ParseOptions& options) {
   namespace fs = std::filesystem;
   const uint64_t limit = options.limits.maxFileBytes;
   auto tooLarge = [&] {
-    return Error("'" + path + "' is larger than the limit of " + std::to_string(limit) + " bytes");
+    return Error(quoteInput(path) + " is larger than the limit of " + std::to_string(limit) + " bytes");
   };
   std::error_code ec;
   fs::file_status st = fs::status(path, ec);
@@ -1242,7 +1242,7 @@ SceneDesc parseRayFile(const std::string& path, const ParseOptions& options) {
   if (!ec && st.type() == fs::file_type::fifo) {
     // A pipe (render <(generator) or /dev/stdin): read it up to the size limit.
     std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw Error("cannot open '" + path + "': " + std::strerror(errno));
+    if (!f) throw Error("cannot open " + quoteInput(path) + ": " + std::strerror(errno));
     char buf[1 << 16];
     size_t n;
     while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) {
@@ -1256,7 +1256,7 @@ SceneDesc parseRayFile(const std::string& path, const ParseOptions& options) {
   } else {
     // Devices and sockets could block or never end (/dev/zero).
     if (!ec && fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st))
-      throw Error("cannot read '" + path + "': not a regular file");
+      throw Error("cannot read " + quoteInput(path) + ": not a regular file");
     auto size = fs::file_size(path, ec);
     if (!ec && size > limit) throw tooLarge();
     text = readFile(path);

@@ -171,6 +171,15 @@ TEST(RayParserValues, CoordinatesAreBounded) {
   EXPECT_NO_THROW(parse("camera { position = (0,0,1e15); }\npoint_light { colour = (1e30,1,1); }"));
 }
 
+// Issue 23: identifiers, strings and paths in messages are shortened and escaped.
+TEST(RayParserValues, MessagesQuoteInputSafely) {
+  std::string longName(100000, 'q');
+  std::string e = error(longName + " {}");
+  EXPECT_EQ(e, "t.ray:2:1: error: unknown keyword '" + std::string(80, 'q') + "...'");
+  EXPECT_EQ(error("camera { position = \"a\x1b[2Jb\"; }"), "t.ray:2:21: error: expected '(', got string \"a\\x1b[2Jb\"");
+  EXPECT_EQ(error("camera { position = \"x\ty\"; }"), "t.ray:2:21: error: expected '(', got string \"x\\ty\"");
+}
+
 TEST(RayParserValues, TupleArity) {
   EXPECT_EQ(error("camera {\n  position = (1,2);\n}"), "t.ray:3:14: error: expected 3 numbers, got 2");
   EXPECT_EQ(error("camera { position = (1,2,3,4); }"), "t.ray:2:21: error: expected 3 numbers, got 4");
