@@ -1104,7 +1104,7 @@ void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
       list([&] {
         Token open = lex_.peek();
         checkMeshLimits(open, mesh.points.size() + 1, 0);
-        mesh.points.push_back(coord());
+        mesh.points.push_back(vec3());  // not bounded: OBJ vertices are not either (obj2ray)
       });
       pointsDone = true;
     } else if (a == "faces") {
