@@ -235,6 +235,10 @@ std::vector<Row> catalogue() {
       ray("nan", "camera { fov = nan; }", "nan.ray:2:16: error: expected a number, got 'nan'"),
       ray("float_overflow", "point_light { position = (1e300, 0, 0); }",
           "float_overflow.ray:2:27: error: number 1e300 is out of range for a float"),
+      ray("coordinate_too_large", "camera { position = (0,0,1e19); }",
+          "coordinate_too_large.ray:2:26: error: number 1e19 is too large for a coordinate (at most 1e15 in magnitude)"),
+      ray("index_too_large", "sphere { material = { transmissive = (1,1,1); index = 1e20; }; }",
+          "index_too_large.ray:2:55: error: index must be at most 1000, got 1e20"),
       ray("value_out_of_range", "camera { fov = 200; }",
           "value_out_of_range.ray:2:16: error: fov must be between 0 and 180 degrees, got 200"),
       ray("negative_attenuation", "point_light { constant_attenuation_coeff = -1; }",
@@ -270,7 +274,7 @@ std::vector<Row> catalogue() {
       ray("degenerate_area_light", "area_light { u = (1,0,0); v = (2,0,0); }",
           "degenerate_area_light.ray:2:1: error: area_light has zero area (u and v are parallel or zero)"),
       ray("area_light_overflow", "area_light { position = (3e38,0,0); u = (1e38,0,0); v = (0,1,0); }",
-          "area_light_overflow.ray:2:1: error: area_light corners are out of range for a float"),
+          "area_light_overflow.ray:2:26: error: number 3e38 is too large for a coordinate (at most 1e15 in magnitude)"),
       // ---- files
       ray("missing_obj", "obj_mesh { file = \"nothere.obj\"; }",
           "missing_obj.ray:2:1: error: cannot open OBJ file 'nothere.obj': No such file or directory"),
@@ -363,6 +367,35 @@ std::vector<Row> catalogue() {
                 {"--stats", "missing/stats.json"});
     rows.push_back(r);
   }
+  // ---- colliding paths (issue 23: the later write used to win, or the input was overwritten)
+  rows.push_back(ray("stats_is_the_image", "sphere {}",
+                     "'out.png' is given as both -o and --stats; use different files",
+                     {"--stats", "out.png"}));
+  rows.push_back(ray("heatmap_is_the_image", "sphere {}",
+                     "'./out.png' (--cut-heatmap) is the same file as 'out.png' (-o); use different files",
+                     {"--cut-heatmap", "./out.png"}));
+  {
+    Row r = ray("output_is_the_scene", "sphere {}",
+                "'output_is_the_scene.ray' is given as both the scene and -o; use different files");
+    r.args = {"render", "output_is_the_scene.ray", "-o", "output_is_the_scene.ray", "-q"};
+    rows.push_back(r);
+  }
+  {
+    Row r;
+    r.name = "obj2ray_overwrites_input";
+    r.files = {{"in.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"}};
+    r.args = {"obj2ray", "in.obj", "-o", "in.obj"};
+    r.message = "'in.obj' is given as both the input OBJ and -o; use different files";
+    rows.push_back(r);
+  }
+  {
+    Row r;
+    r.name = "heatmap_overwrites_reference";
+    r.files = {{"a.ppm", "P6\n1 1\n255\nabc"}, {"b.ppm", "P6\n1 1\n255\nabc"}};
+    r.args = {"compare", "a.ppm", "b.ppm", "--heatmap", "a.ppm"};
+    r.message = "'a.ppm' is given as both the reference image and --heatmap; use different files";
+    rows.push_back(r);
+  }
   // ---- limits (the tests in CliLimits below cover each flag in more detail)
   rows.push_back(ray("limit_triangles",
                      "trimesh { points = ((0,0,0),(1,0,0),(0,1,0),(1,1,0)); "
@@ -377,6 +410,12 @@ std::vector<Row> catalogue() {
                      {"--max-nesting", "2"}));
   rows.push_back(ray("limit_image_pixels", "sphere {}", "an image of 100x100 exceeds --max-image-pixels (1000)",
                      {"--width", "100", "--height", "100", "--max-image-pixels", "1000"}));
+  rows.push_back(ray("aspect_ratio_too_wide", "camera { aspectratio = 3e9; }",
+                     "aspectratio 3000000000 makes the image 3000000000x1: more than 65536 pixels wide (give both --width and --height)",
+                     {"--height", "1"}));
+  rows.push_back(ray("aspect_ratio_too_high", "camera { aspectratio = 0.0001; }",
+                     "aspectratio 0.0001 makes the image 10x100000: more than 65536 pixels high (give both --width and --height)",
+                     {"--width", "10"}));
   rows.push_back(ray("limit_objects", "sphere {} sphere {} sphere {}",
                      "limit_objects.ray:2:21: error: more objects and materials than the limit of 3 (raise it with --max-objects)",
                      {"--max-objects", "3"}));
@@ -430,6 +469,28 @@ TEST(CliUsage, OutOfRangeOptionIsAUsageError) {
   EXPECT_EQ(r.status, 105);
   EXPECT_NE(r.err.find("--width: Value 0 not in range 1 to 65536"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir.file("out.png")));
+}
+
+// Issue 23: limits take whole numbers >= 0; -1 used to wrap around to no limit at all
+// (--max-lights, --max-image-pixels) or to read "a limit of -1 levels" (--max-nesting).
+TEST(CliUsage, NegativeLimitsAreUsageErrors) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + "point_light {} sphere {}");
+  for (const char* flag : {"--max-lights", "--max-vpls", "--max-triangles", "--max-nesting", "--max-objects",
+                           "--max-image-pixels", "--max-texture-pixels"}) {
+    for (const char* value : {"-1", "1.5", "x"}) {
+      CliResult r = run({"render", "s.ray", "-o", "out.png", "-q", flag, value}, dir.path());
+      EXPECT_EQ(r.status, 105) << flag << " " << value << ": " << r.err;
+      EXPECT_NE(r.err.find(std::string(flag) + ": a limit must be a whole number >= 0 (0 allows none), got " + value),
+                std::string::npos)
+          << r.err;
+      EXPECT_FALSE(fs::exists(dir.file("out.png")));
+    }
+  }
+  // 0 is a limit like any other: it allows none.
+  CliResult r = run({"info", "s.ray", "--max-lights", "0"}, dir.path());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("more lights than the limit of 0"), std::string::npos) << r.err;
 }
 
 // A valid scene renders: status 0 and the file exists (the baseline for the rows above).

@@ -21,6 +21,9 @@ struct CompareArgs {
 };
 
 int runCompare(const CompareArgs& a) {
+  // (comparing an image with itself is fine; overwriting either with the heatmap is not)
+  checkDistinctPaths({{a.ref, "the reference image"}, {a.heatmap, "--heatmap"}});
+  checkDistinctPaths({{a.test, "the test image"}, {a.heatmap, "--heatmap"}});
   if (!a.heatmap.empty()) checkWritable(a.heatmap);
   io::Image ref = io::readImage(a.ref), test = io::readImage(a.test);
   io::ImageMetrics m = io::compareImages(ref, test, a.threshold);
@@ -68,6 +71,7 @@ void addObj2RayCommand(CLI::App& app) {
   c->add_option("input", *in, "OBJ file")->required();
   c->add_option("-o,--output", *out, "Output .ray file")->required();
   c->callback([in, out] {
+    checkDistinctPaths({{*in, "the input OBJ"}, {*out, "-o"}});
     io::writeRayFromObj(*in, *out, Limits{});
     fmt::print("wrote {}\n", *out);
     exitStatus() = 0;

@@ -23,6 +23,8 @@ namespace lc::app {
 
 namespace {
 
+constexpr int kMaxImageSide = 1 << 16;  // --width, --height and sizes from the aspect ratio
+
 std::atomic<bool> gInterrupted{false};
 extern "C" void onSignal(int) { gInterrupted.store(true); }
 
@@ -97,6 +99,7 @@ std::string defaultOutput(const std::string& scene) {
 int runRender(RenderArgs& a) {
   auto t0 = std::chrono::steady_clock::now();
   if (a.out.empty()) a.out = defaultOutput(a.scene);
+  checkDistinctPaths({{a.scene, "the scene"}, {a.out, "-o"}, {a.stats, "--stats"}, {a.cutHeatmap, "--cut-heatmap"}});
   std::string ext = fileExtension(a.out);
   if (std::filesystem::is_directory(a.out)) throw Error("cannot write '" + a.out + "': it is a directory");
   if (ext.empty())
@@ -129,10 +132,21 @@ int runRender(RenderArgs& a) {
 
   // Image size: from the flags, completing the missing one from the aspect ratio.
   const auto& cam = scene.desc().camera;
-  float aspect = cam.aspectRatio ? *cam.aspectRatio : 1.0f;
+  // In double, checked against the flags' bound before converting: an aspect ratio of 3e9
+  // would otherwise overflow int (and wrap to a 1-pixel or negative size).
+  double aspect = cam.aspectRatio ? double(*cam.aspectRatio) : 1.0;
   if (a.width <= 0 && a.height <= 0) a.width = 512;
-  if (a.width > 0 && a.height <= 0) a.height = std::max(1, int(std::lround(float(a.width) / aspect)));
-  if (a.height > 0 && a.width <= 0) a.width = std::max(1, int(std::lround(float(a.height) * aspect)));
+  if (a.width <= 0 || a.height <= 0) {
+    bool fromWidth = a.width > 0;
+    double other = std::max(1.0, std::round(fromWidth ? a.width / aspect : a.height * aspect));
+    if (!(other <= kMaxImageSide))
+      throw Error(fmt::format("aspectratio {} makes the image {}: more than {} pixels {} (give both --width and --height)",
+                              float(aspect),
+                              fromWidth ? fmt::format("{}x{:.0f}", a.width, other)
+                                        : fmt::format("{:.0f}x{}", other, a.height),
+                              kMaxImageSide, fromWidth ? "high" : "wide"));
+    (fromWidth ? a.height : a.width) = int(other);
+  }
   if (uint64_t(a.width) * uint64_t(a.height) > a.load.limits.maxImagePixels)
     throw Error(fmt::format("an image of {}x{} exceeds --max-image-pixels ({})", a.width, a.height,
                             a.load.limits.maxImagePixels));
@@ -335,8 +349,9 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("scene", a->scene, "Scene file (.ray or .obj)")->required();
   c->add_option("-o,--output", a->out, "Output image: .png .ppm .bmp (8-bit) or .exr (float); default <scene>.png");
   c->add_option("--width", a->width, "Image width in pixels (default 512; or from --height and the aspect ratio)")
-      ->check(CLI::Range(1, 1 << 16));
-  c->add_option("--height", a->height, "Image height in pixels (default: width / aspect ratio)")->check(CLI::Range(1, 1 << 16));
+      ->check(CLI::Range(1, kMaxImageSide));
+  c->add_option("--height", a->height, "Image height in pixels (default: width / aspect ratio)")
+      ->check(CLI::Range(1, kMaxImageSide));
   c->add_option("--spp", a->spp, "Samples per pixel, stratified (1 = pixel centre)")->check(CLI::Range(1, 65536));
   c->add_option("--threads", a->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024));
   c->add_option("--max-depth", a->maxDepth, "Reflection/refraction recursion depth")->check(CLI::Range(0, 64));

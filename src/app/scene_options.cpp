@@ -2,6 +2,21 @@
 
 namespace lc::app {
 
+namespace {
+
+// Limits take non-negative integers only: a negative one used to wrap around to a huge
+// unsigned value (silently no limit) or to read "a limit of -1". 0 allows none.
+const CLI::Validator kLimitValue(
+    [](std::string& s) -> std::string {
+      size_t i = 0;
+      while (i < s.size() && s[i] >= '0' && s[i] <= '9') ++i;
+      if (s.empty() || i != s.size()) return "a limit must be a whole number >= 0 (0 allows none), got " + s;
+      return {};
+    },
+    "INT>=0");
+
+}  // namespace
+
 void addSceneOptions(CLI::App& c, LoadOptions& o) {
   c.add_flag("--lenient", o.lenient, "Skip unknown keywords in .ray files with a warning instead of failing");
   c.add_option("--object-lights", [&o](const CLI::results_t& r) {
@@ -28,14 +43,21 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
   c.add_option_function<std::string>("--gi", [&o](const std::string& v) { o.gi = v == "on"; },
                                      "Global illumination from VPLs: on (default) or off")
       ->check(CLI::IsMember({"on", "off"}));
-  c.add_option("--max-lights", o.limits.maxLights, "Limit on lights (object lights, VPLs and scene lights)");
-  c.add_option("--max-vpls", o.limits.maxVpls, "Limit on VPLs");
+  c.add_option("--max-lights", o.limits.maxLights, "Limit on lights (object lights, VPLs and scene lights)")
+      ->check(kLimitValue);
+  c.add_option("--max-vpls", o.limits.maxVpls, "Limit on VPLs")
+      ->check(kLimitValue);
   c.add_option_function<uint64_t>("--max-triangles", [&o](const uint64_t& v) { o.limits.maxTriangles = o.limits.maxVertices = v; },
-                                  "Limit on triangles (and vertices) in all meshes");
-  c.add_option("--max-nesting", o.limits.maxNesting, "Limit on nested transforms and groups in .ray files");
-  c.add_option("--max-objects", o.limits.maxObjects, "Limit on primitives and materials in a .ray file");
-  c.add_option("--max-image-pixels", o.limits.maxImagePixels, "Limit on width x height");
-  c.add_option("--max-texture-pixels", o.limits.maxTexturePixels, "Limit on the pixels of one texture");
+                                  "Limit on triangles (and vertices) in all meshes")
+      ->check(kLimitValue);
+  c.add_option("--max-nesting", o.limits.maxNesting, "Limit on nested transforms and groups in .ray files")
+      ->check(kLimitValue);
+  c.add_option("--max-objects", o.limits.maxObjects, "Limit on primitives and materials in a .ray file")
+      ->check(kLimitValue);
+  c.add_option("--max-image-pixels", o.limits.maxImagePixels, "Limit on width x height")
+      ->check(kLimitValue);
+  c.add_option("--max-texture-pixels", o.limits.maxTexturePixels, "Limit on the pixels of one texture")
+      ->check(kLimitValue);
 }
 
 }  // namespace lc::app

@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace lc {
 
@@ -29,6 +30,13 @@ class Error : public std::runtime_error {
   SourceLoc loc_;
   mutable std::string bare_;
 };
+
+// Input echoed in a message, made safe for a terminal and a one-line message: control
+// characters escaped (\n, \t, \r, \x1b ...), at most `maxLen` bytes of the input kept (then
+// "..."), in single quotes. quoteInput("a\x1bb") == "'a\\x1bb'". escapeInput: the same
+// without the quotes (file names in locations).
+std::string escapeInput(std::string_view s, size_t maxLen = 80);
+std::string quoteInput(std::string_view s, size_t maxLen = 80);
 
 // Thrown when a render is interrupted (SIGINT/SIGTERM).
 class Interrupted : public std::runtime_error {

@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace lc {
 
@@ -18,6 +19,16 @@ void writeFileAtomically(const std::string& path,
 // Throws lc::Error when a file could not be created at `path` (missing or unwritable
 // directory), so a long render fails before it starts rather than after.
 void checkWritable(const std::string& path);
+
+// A file the command reads or writes, with what it is ("the output image (-o)").
+struct NamedPath {
+  std::string path;  // "" = not given (skipped)
+  std::string role;
+};
+// Throws lc::Error when two of `paths` name the same file (compared with
+// std::filesystem::weakly_canonical, so "o.png", "./o.png" and a symlink to it collide):
+// an output must not overwrite an input or another output of the same command.
+void checkDistinctPaths(const std::vector<NamedPath>& paths);
 
 // Lower-case extension without the dot ("png"), or "" when there is none.
 std::string fileExtension(const std::string& path);

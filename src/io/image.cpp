@@ -40,11 +40,11 @@ std::string normalizeExt(std::string ext) {
 // Writes `bytes` to `tmp`; errors name the final `path`, which is what the user asked for.
 void writeBytes(const std::string& tmp, const std::string& path, const std::vector<uint8_t>& bytes) {
   FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) throw Error("cannot write '" + path + "': " + std::strerror(errno));
+  if (!f) throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(errno));
   size_t n = bytes.empty() ? 0 : std::fwrite(bytes.data(), 1, bytes.size(), f);
   int writeErr = n == bytes.size() ? 0 : (errno ? errno : EIO);
   if (std::fclose(f) != 0 && writeErr == 0) writeErr = errno ? errno : EIO;
-  if (writeErr != 0) throw Error("cannot write '" + path + "': " + std::strerror(writeErr));
+  if (writeErr != 0) throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(writeErr));
 }
 
 std::vector<uint8_t> toBytes(const Image& img, ToneMap tonemap) {
@@ -87,17 +87,17 @@ void writeExr(const std::string& tmp, const std::string& path, const Image& img)
     file.setFrameBuffer(fb);
     file.writePixels(img.height);
   } catch (const std::exception& e) {
-    throw Error("cannot write '" + path + "': " + e.what());
+    throw Error("cannot write " + quoteInput(path) + ": " + e.what());
   }
 }
 
 [[noreturn]] void throwOpen(const std::string& path, const std::string& reason) {
   throw ImageReadError(ImageReadError::Kind::Open, path, reason,
-                       "cannot open '" + path + "': " + reason);
+                       "cannot open " + quoteInput(path) + ": " + reason);
 }
 [[noreturn]] void throwDecode(const std::string& path, const std::string& reason) {
   throw ImageReadError(ImageReadError::Kind::Decode, path, reason,
-                       "cannot read image '" + path + "': " + reason);
+                       "cannot read image " + quoteInput(path) + ": " + reason);
 }
 void checkSize(const std::string& path, int w, int h, uint64_t maxPixels) {
   if (w <= 0 || h <= 0) throwDecode(path, "empty image");
@@ -106,7 +106,7 @@ void checkSize(const std::string& path, int w, int h, uint64_t maxPixels) {
     std::string reason = std::to_string(w) + "x" + std::to_string(h) + " = " + std::to_string(n) +
                          " pixels, more than the limit of " + std::to_string(maxPixels);
     throw ImageReadError(ImageReadError::Kind::TooLarge, path, reason,
-                         "image '" + path + "' is " + reason, w, h);
+                         "image " + quoteInput(path) + " is " + reason, w, h);
   }
 }
 
@@ -495,16 +495,16 @@ bool isWritableImageExtension(const std::string& ext) {
 void writeImage(const std::string& path, const Image& image, ToneMap tonemap) {
   const std::string ext = fileExtension(path);
   if (!isWritableImageExtension(ext)) {
-    if (ext.empty()) throw Error("cannot write '" + path + "': no image format extension " + kFormatsHint);
+    if (ext.empty()) throw Error("cannot write " + quoteInput(path) + ": no image format extension " + kFormatsHint);
     // Report the extension as the user spelled it.
     std::string given = std::filesystem::path(path).extension().string();
-    throw Error("cannot write '" + path + "': unknown image format '" + given + "' " + kFormatsHint);
+    throw Error("cannot write " + quoteInput(path) + ": unknown image format " + quoteInput(given) + " " + kFormatsHint);
   }
   if (image.width <= 0 || image.height <= 0)
-    throw Error("cannot write '" + path + "': empty image (" + std::to_string(image.width) + "x" +
+    throw Error("cannot write " + quoteInput(path) + ": empty image (" + std::to_string(image.width) + "x" +
                 std::to_string(image.height) + ")");
   if (image.pixels.size() != size_t(image.width) * size_t(image.height))
-    throw Error("cannot write '" + path + "': pixel count does not match " +
+    throw Error("cannot write " + quoteInput(path) + ": pixel count does not match " +
                 std::to_string(image.width) + "x" + std::to_string(image.height));
 
   if (ext == "exr") {
@@ -522,7 +522,7 @@ void writeImage(const std::string& path, const Image& image, ToneMap tonemap) {
                                                    rgb.data(), image.width * 3)
                           : stbi_write_bmp_to_func(appendToVector, &encoded, image.width, image.height, 3,
                                                    rgb.data());
-    if (!ok) throw Error("cannot write '" + path + "': the " + ext + " encoder failed");
+    if (!ok) throw Error("cannot write " + quoteInput(path) + ": the " + ext + " encoder failed");
   }
   writeFileAtomically(path, [&](const std::string& tmp) { writeBytes(tmp, path, encoded); });
 }

@@ -295,11 +295,11 @@ ObjScan scanObj(const std::string& text, const std::string& path, const Limits& 
                       " '" + kIndexLine[k] + "' lines");
 
   if (scan.triangles > limits.maxTriangles)
-    throwLimit(referredFrom, "OBJ file '" + path + "' has " + std::to_string(scan.triangles) +
+    throwLimit(referredFrom, "OBJ file " + quoteInput(path) + " has " + std::to_string(scan.triangles) +
                 " triangles, more than the limit of " + std::to_string(limits.maxTriangles) +
                 " (raise it with --max-triangles)");
   if (scan.positions > limits.maxVertices)
-    throwLimit(referredFrom, "OBJ file '" + path + "' has " + std::to_string(scan.positions) +
+    throwLimit(referredFrom, "OBJ file " + quoteInput(path) + " has " + std::to_string(scan.positions) +
                 " vertices, more than the limit of " + std::to_string(limits.maxVertices) +
                 " (raise it with --max-triangles)");
   return scan;
@@ -414,7 +414,7 @@ class MtlReader : public tinyobj::MaterialReader {
       std::error_code ec;
       uintmax_t size = fs::file_size(p, ec);
       if (!ec && size > limits_.maxFileBytes) {
-        if (err) *err += "material library '" + p + "' is larger than " +
+        if (err) *err += "material library " + quoteInput(p) + " is larger than " +
                          std::to_string(limits_.maxFileBytes) + " bytes\n";
         return false;
       }
@@ -432,7 +432,7 @@ class MtlReader : public tinyobj::MaterialReader {
       // tinyobj's MTL warnings are about d/Tr precedence, which we document instead.
       return true;
     }
-    std::string msg = objPath_ + ": warning: material library '" + matId + "' not found (looked for";
+    std::string msg = objPath_ + ": warning: material library " + quoteInput(matId) + " not found (looked for";
     for (size_t i = 0; i < candidates.size(); ++i) msg += (i ? ", '" : " '") + candidates[i] + "'";
     msg += "); using default materials";
     missing.push_back(msg);
@@ -466,7 +466,7 @@ std::optional<TextureRef> textureRef(const std::string& name, const std::string&
         fs::path(resolveRelative(dir, fs::path(n).filename().string())).lexically_normal().string();
     if (!isRegularFile(alt)) {
       warnings.push_back(SourceLoc{mtlPath, line, 0}.str() + ": warning: texture '" + name +
-                         "' not found (looked for '" + p + "'" + (alt != p ? " and '" + alt + "'" : "") +
+                         "' not found (looked for " + quoteInput(p) + "" + (alt != p ? " and " + quoteInput(alt) + "" : "") +
                          "); using the constant colour");
       return std::nullopt;
     }
@@ -556,7 +556,7 @@ int lineFromTinyobj(const std::string& msg) {
 
 void openCheck(const std::string& path, const SourceLoc& referredFrom, const Limits& limits) {
   auto fail = [&](const std::string& why) {
-    std::string msg = "cannot open OBJ file '" + path + "': " + why;
+    std::string msg = "cannot open OBJ file " + quoteInput(path) + ": " + why;
     if (referredFrom.line > 0) throw Error(referredFrom, msg);
     throw Error(msg);
   };
@@ -644,7 +644,7 @@ ObjData loadObj(const std::string& path, const SourceLoc& referredFrom, const Ma
     triCount += mesh.num_face_vertices.size();
   }
   if (triCount > limits.maxTriangles)
-    throwLimit(referredFrom, "OBJ file '" + path + "' has " + std::to_string(triCount) +
+    throwLimit(referredFrom, "OBJ file " + quoteInput(path) + " has " + std::to_string(triCount) +
                 " triangles, more than the limit of " + std::to_string(limits.maxTriangles) +
                 " (raise it with --max-triangles)");
 
@@ -689,7 +689,7 @@ ObjData loadObj(const std::string& path, const SourceLoc& referredFrom, const Ma
         auto [it, inserted] = vertexOf.try_emplace(key, int(mesh.points.size()));
         if (inserted) {
           if (mesh.points.size() >= limits.maxVertices)
-            throwLimit(referredFrom, "OBJ file '" + path + "' has more than " +
+            throwLimit(referredFrom, "OBJ file " + quoteInput(path) + " has more than " +
                         std::to_string(limits.maxVertices) +
                         " distinct vertices (raise it with --max-triangles)");
           const size_t v = size_t(key.v);

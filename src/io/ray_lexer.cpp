@@ -28,11 +28,11 @@ std::string showChar(char c) {
 std::string Token::describe() const {
   switch (kind) {
     case TokenKind::Ident:
-      return quoted ? "string \"" + text + "\"" : "'" + text + "'";
+      return quoted ? "string \"" + escapeInput(text) + "\"" : quoteInput(text);
     case TokenKind::Number:
       return "number " + text;
     case TokenKind::Bool:
-      return "'" + text + "'";
+      return quoteInput(text);
     case TokenKind::Punct:
       return std::string("'") + punct + "'";
     case TokenKind::End:
@@ -167,7 +167,7 @@ void RayLexer::scan(Token& t) {
     size_t end = p;
     while (isIdentStart(at(end)) || isDigit(at(end)) || at(end) == '.') ++end;
     std::string spelled(text_.substr(start, end - start));
-    if (end != p) fail(t.line, t.column, "malformed number '" + spelled + "'");
+    if (end != p) fail(t.line, t.column, "malformed number " + quoteInput(spelled) + "");
     while (pos_ < p) advance();
 
     // from_chars is locale-independent but rejects a leading '+'.
@@ -179,9 +179,9 @@ void RayLexer::scan(Token& t) {
       // Overflow is an error; underflow reads as the nearest representable value.
       errno = 0;
       v = std::strtod(b, nullptr);
-      if (std::isinf(v)) fail(t.line, t.column, "number '" + spelled + "' is out of range");
+      if (std::isinf(v)) fail(t.line, t.column, "number " + quoteInput(spelled) + " is out of range");
     } else if (ec != std::errc() || ptr != e) {
-      fail(t.line, t.column, "malformed number '" + spelled + "'");
+      fail(t.line, t.column, "malformed number " + quoteInput(spelled) + "");
     }
     t.kind = TokenKind::Number;
     t.text = spelled;

@@ -151,10 +151,23 @@ class Parser {
   }
   Token nameValue();
   // "(a, b, ...)" with exactly n numbers; `open` receives the '(' token.
-  void tuple(int n, double* out, bool asFloat, Token* open = nullptr);
+  // `bounded`: each number is checked with checkCoordinate.
+  void tuple(int n, double* out, bool asFloat, Token* open = nullptr, bool bounded = false);
   Vec3 vec3(Token* open = nullptr) {
     double d[3];
     tuple(3, d, true, open);
+    return Vec3(float(d[0]), float(d[1]), float(d[2]));
+  }
+  // A position, direction or transform entry: |value| <= kMaxCoordinate, so that rays,
+  // bounds and transforms stay far from float overflow (Embree refuses rays beyond ~1.8e18).
+  static constexpr double kMaxCoordinate = 1e15;
+  void checkCoordinate(const Token& t) const {
+    if (!(std::fabs(t.number) <= kMaxCoordinate))
+      fail(t, "number " + t.text + " is too large for a coordinate (at most 1e15 in magnitude)");
+  }
+  Vec3 coord(Token* open = nullptr) {
+    double d[3];
+    tuple(3, d, true, open, true);
     return Vec3(float(d[0]), float(d[1]), float(d[2]));
   }
   // "( item, item, ... )" calling item() for each entry.
@@ -211,7 +224,7 @@ class Parser {
 // ---------------------------------------------------------------------------------------
 // Values
 
-void Parser::tuple(int n, double* out, bool asFloat, Token* openOut) {
+void Parser::tuple(int n, double* out, bool asFloat, Token* openOut, bool bounded) {
   Token open = lex_.next();
   if (!open.isPunct('(')) expected("'('", open);
   int count = 0;
@@ -222,6 +235,7 @@ void Parser::tuple(int n, double* out, bool asFloat, Token* openOut) {
       Token t = lex_.next();
       if (t.kind != TokenKind::Number) expected("a number", t);
       if (count < n) out[count] = asFloat ? double(toFloat(t)) : t.number;
+      if (bounded) checkCoordinate(t);
       ++count;
       Token sep = lex_.next();
       if (sep.isPunct(')')) break;
@@ -341,7 +355,7 @@ void Parser::block(const std::string& what, F&& onAttr) {
 }
 
 void Parser::unknown(const Token& key, const std::string& context) {
-  std::string msg = "unknown keyword '" + key.text + "'";
+  std::string msg = "unknown keyword " + quoteInput(key.text) + "";
   if (!context.empty()) msg += " in " + context;
   if (!opt_.lenient) fail(key, msg);
   scene_.warnings.push_back(lex_.loc(key).str() + ": warning: " + msg + " (skipped)");
@@ -450,7 +464,7 @@ int Parser::materialValue(int baseIndex) {
   if (t.kind == TokenKind::Ident) {
     Token n = lex_.next();
     auto it = named_.find(n.text);
-    if (it == named_.end()) fail(n, "unknown material '" + n.text + "'");
+    if (it == named_.end()) fail(n, "unknown material " + quoteInput(n.text) + "");
     return it->second;
   }
   expected("a material block '{...}' or a material name", lex_.next());
@@ -495,6 +509,8 @@ int Parser::materialBlock(int baseIndex) {
       if (w == "shininess" && !s.map && !(s.value >= 0))
         fail(vt, "shininess must be >= 0, got " + vt.text);
       if (w == "index" && !s.map && !(s.value > 0)) fail(vt, "index must be > 0, got " + vt.text);
+      if (w == "index" && !s.map && !(s.value <= 1000))
+        fail(vt, "index must be at most 1000, got " + vt.text);
       (w == "shininess" ? m.shininess : m.index) = s;
     } else if (w == "name") {
       Token at = nameValue();
@@ -502,7 +518,7 @@ int Parser::materialBlock(int baseIndex) {
       if (!n.empty()) {
         auto it = named_.find(n);
         if (it != named_.end())
-          fail(at, "material '" + n + "' is already declared (at " +
+          fail(at, "material " + quoteInput(n) + " is already declared (at " +
                        scene_.materials[size_t(it->second)].loc.str() + ")");
       }
       m.name = n;
@@ -586,16 +602,16 @@ void Parser::camera(const Token& kw) {
       return false;
     expectEquals();
     if (w == "position") {
-      c.position = vec3();
+      c.position = coord();
     } else if (w == "viewdir") {
-      c.viewDir = vec3(&viewTok);
+      c.viewDir = coord(&viewTok);
       if (length2(c.viewDir) == 0) fail(viewTok, "viewdir must not be zero");
       haveLookAt = false;
     } else if (w == "updir") {
-      c.upDir = vec3(&upTok);
+      c.upDir = coord(&upTok);
       if (length2(c.upDir) == 0) fail(upTok, "updir must not be zero");
     } else if (w == "look_at") {
-      lookAt = vec3(&lookTok);
+      lookAt = coord(&lookTok);
       haveLookAt = true;
     } else if (w == "quaternion") {
       Token open;
@@ -690,16 +706,16 @@ void Parser::light(const Token& kw) {
       l.colour = vec3();
     } else if (w == "position" && positional) {
       expectEquals();
-      l.position = vec3();
+      l.position = coord();
     } else if (w == "direction" && (spot || !positional)) {
       expectEquals();
       Token open;
-      l.direction = vec3(&open);
+      l.direction = coord(&open);
       if (length2(l.direction) == 0) fail(open, "direction must not be zero");
       haveTarget = false;
     } else if (w == "target" && spot) {
       expectEquals();
-      target = vec3(&targetTok);
+      target = coord(&targetTok);
       haveTarget = true;
     } else if (w == "constant_attenuation_coeff" && positional) {
       expectEquals();
@@ -769,7 +785,7 @@ void Parser::areaLight(const Token& kw) {
     const std::string& w = k.word;
     if (w != "position" && w != "u" && w != "v" && w != "color") return false;
     expectEquals();
-    Vec3 x = vec3();
+    Vec3 x = w == "color" ? vec3() : coord();
     if (w == "position") corner = x;
     else if (w == "u") u = x, haveU = true;
     else if (w == "v") v = x, haveV = true;
@@ -866,7 +882,11 @@ void Parser::node() {
     if (isTransformWord(t)) {
       Mat4 m = transformArgs(t);
       Mat4 xf = currentTransform() * m;
-      if (!xf.isFinite()) fail(t, "transform overflows (the accumulated matrix is not finite)");
+      // Each argument is at most 1e15 (checkCoordinate); nesting can still multiply them up.
+      bool tooLarge = !xf.isFinite();
+      for (const auto& row : xf.m)
+        for (double v : row) tooLarge = tooLarge || !(std::fabs(v) <= 1e30);
+      if (tooLarge) fail(t, "transform overflows (an entry of the accumulated matrix exceeds 1e30)");
       pushFrame(false, xf, t);
       continue;  // its child node follows
     }
@@ -931,6 +951,7 @@ Mat4 Parser::transformArgs(const Token& kw) {
   expectPunct('(');
   auto arg = [&](Token* tok = nullptr) {
     Token t = numberToken();
+    checkCoordinate(t);
     expectPunct(',');
     if (tok) *tok = t;
     return t.number;
@@ -966,7 +987,7 @@ Mat4 Parser::transformArgs(const Token& kw) {
   Token rowTok[4];
   for (int r = 0; r < 4; ++r) {
     double row[4];
-    tuple(4, row, false, &rowTok[r]);
+    tuple(4, row, false, &rowTok[r], true);
     for (int c = 0; c < 4; ++c) m.m[size_t(r)][size_t(c)] = row[c];
     expectPunct(',');
   }
@@ -1055,7 +1076,7 @@ void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
   std::vector<Pos> deferred;  // index positions when faces precede points
   bool pointsDone = false;
   auto once = [&](int i, const Token& k) {
-    if (seen[i]) fail(k, "'" + k.text + "' is given twice in " + kw.text);
+    if (seen[i]) fail(k, quoteInput(k.text) + " is given twice in " + kw.text);
     seen[i] = true;
     listTok[i] = k;
     expectEquals();
@@ -1083,7 +1104,7 @@ void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
       list([&] {
         Token open = lex_.peek();
         checkMeshLimits(open, mesh.points.size() + 1, 0);
-        mesh.points.push_back(vec3());
+        mesh.points.push_back(vec3());  // not bounded: OBJ vertices are not either (obj2ray)
       });
       pointsDone = true;
     } else if (a == "faces") {
@@ -1203,7 +1224,7 @@ void Parser::objMesh(const Token& kw, ObjectDesc& obj) {
 SceneDesc parseRayString(const std::string& text, const std::string& name, const std::string& baseDir,
                          const ParseOptions& options) {
   if (text.size() > options.limits.maxFileBytes)
-    throw Error("'" + name + "' is larger than the limit of " + std::to_string(options.limits.maxFileBytes) +
+    throw Error(quoteInput(name) + " is larger than the limit of " + std::to_string(options.limits.maxFileBytes) +
                 " bytes");
   Parser parser(text, name, baseDir, options);
   return parser.run();
@@ -1213,7 +1234,7 @@ SceneDesc parseRayFile(const std::string& path, const ParseOptions& options) {
   namespace fs = std::filesystem;
   const uint64_t limit = options.limits.maxFileBytes;
   auto tooLarge = [&] {
-    return Error("'" + path + "' is larger than the limit of " + std::to_string(limit) + " bytes");
+    return Error(quoteInput(path) + " is larger than the limit of " + std::to_string(limit) + " bytes");
   };
   std::error_code ec;
   fs::file_status st = fs::status(path, ec);
@@ -1221,7 +1242,7 @@ SceneDesc parseRayFile(const std::string& path, const ParseOptions& options) {
   if (!ec && st.type() == fs::file_type::fifo) {
     // A pipe (render <(generator) or /dev/stdin): read it up to the size limit.
     std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw Error("cannot open '" + path + "': " + std::strerror(errno));
+    if (!f) throw Error("cannot open " + quoteInput(path) + ": " + std::strerror(errno));
     char buf[1 << 16];
     size_t n;
     while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) {
@@ -1235,7 +1256,7 @@ SceneDesc parseRayFile(const std::string& path, const ParseOptions& options) {
   } else {
     // Devices and sockets could block or never end (/dev/zero).
     if (!ec && fs::exists(st) && !fs::is_regular_file(st) && !fs::is_directory(st))
-      throw Error("cannot read '" + path + "': not a regular file");
+      throw Error("cannot read " + quoteInput(path) + ": not a regular file");
     auto size = fs::file_size(path, ec);
     if (!ec && size > limit) throw tooLarge();
     text = readFile(path);

@@ -137,12 +137,47 @@ TEST(RayParserValues, NumbersMustBeFinite) {
   // Finite as a double but not as a float.
   EXPECT_EQ(error("camera { position = (1, 1e39, 0); }"),
             "t.ray:2:25: error: number 1e39 is out of range for a float");
-  // Transforms keep doubles: 1e39 is fine there.
-  SceneDesc s = parse("translate(1e39, 0, 0, sphere {})");
-  EXPECT_EQ(s.objects[0].transform.m[0][3], 1e39);
+  // Transforms keep doubles, but coordinates are bounded (below).
+  SceneDesc s = parse("translate(1e15, 0, 0, sphere {})");
+  EXPECT_EQ(s.objects[0].transform.m[0][3], 1e15);
   // Words that other languages read as numbers are not numbers here.
   EXPECT_EQ(error("camera { fov = inf; }"), "t.ray:2:16: error: expected a number, got 'inf'");
   EXPECT_EQ(error("camera { fov = nan; }"), "t.ray:2:16: error: expected a number, got 'nan'");
+}
+
+// Issue 23: positions, directions and transform entries beyond 1e15 in magnitude are refused
+// at the number (Embree aborts on rays whose origin lies beyond ~1.8e18); so is an index that
+// makes refraction degenerate.
+TEST(RayParserValues, CoordinatesAreBounded) {
+  const std::string tail = " is too large for a coordinate (at most 1e15 in magnitude)";
+  EXPECT_EQ(error("camera { position = (0,0,1e19); }"), "t.ray:2:26: error: number 1e19" + tail);
+  EXPECT_EQ(error("camera { look_at = (0,-2e15,0); }"), "t.ray:2:23: error: number -2e15" + tail);
+  EXPECT_EQ(error("camera { viewdir = (1e16,0,0); }"), "t.ray:2:21: error: number 1e16" + tail);
+  EXPECT_EQ(error("camera { updir = (0,1e16,0); }"), "t.ray:2:21: error: number 1e16" + tail);
+  EXPECT_EQ(error("point_light { position = (1e16,0,0); }"), "t.ray:2:27: error: number 1e16" + tail);
+  EXPECT_EQ(error("directional_light { direction = (0,0,-1e16); }"), "t.ray:2:38: error: number -1e16" + tail);
+  EXPECT_EQ(error("spot_light { target = (0,0,1e16); }"), "t.ray:2:28: error: number 1e16" + tail);
+  EXPECT_EQ(error("area_light { position = (1e16,0,0); u = (1,0,0); v = (0,1,0); }"),
+            "t.ray:2:26: error: number 1e16" + tail);
+  EXPECT_EQ(error("translate(1e19, 0, 0, sphere {})"), "t.ray:2:11: error: number 1e19" + tail);
+  EXPECT_EQ(error("scale(1e16, sphere {})"), "t.ray:2:7: error: number 1e16" + tail);
+  EXPECT_EQ(error("transform((1,0,0,1e16),(0,1,0,0),(0,0,1,0),(0,0,0,1), sphere {})"),
+            "t.ray:2:18: error: number 1e16" + tail);
+  EXPECT_EQ(error("sphere { material = { transmissive = (1,1,1); index = 1e20; }; }"),
+            "t.ray:2:55: error: index must be at most 1000, got 1e20");
+  // The bound itself is fine; colours are not coordinates, and mesh points (like OBJ vertices)
+  // are only bounded by the float range: the renderer drops rays that leave Embree's range.
+  EXPECT_NO_THROW(parse("trimesh { points = ((0,0,0),(1e30,0,0),(0,1,0)); faces = ((0,1,2)); }"));
+  EXPECT_NO_THROW(parse("camera { position = (0,0,1e15); }\npoint_light { colour = (1e30,1,1); }"));
+}
+
+// Issue 23: identifiers, strings and paths in messages are shortened and escaped.
+TEST(RayParserValues, MessagesQuoteInputSafely) {
+  std::string longName(100000, 'q');
+  std::string e = error(longName + " {}");
+  EXPECT_EQ(e, "t.ray:2:1: error: unknown keyword '" + std::string(80, 'q') + "...'");
+  EXPECT_EQ(error("camera { position = \"a\x1b[2Jb\"; }"), "t.ray:2:21: error: expected '(', got string \"a\\x1b[2Jb\"");
+  EXPECT_EQ(error("camera { position = \"x\ty\"; }"), "t.ray:2:21: error: expected '(', got string \"x\\ty\"");
 }
 
 TEST(RayParserValues, TupleArity) {
@@ -623,8 +658,8 @@ TEST(RayParserTransforms, Errors) {
   EXPECT_EQ(error("translate(1, 2, 3, sphere {} box {})"),
             "t.ray:2:30: error: expected ')' to close translate opened at 2:1, got 'box'");
   EXPECT_EQ(error("{ camera {} }"), "t.ray:2:3: error: expected a primitive, transform or '{', got 'camera'");
-  EXPECT_EQ(error("translate(1e300, 0, 0, scale(1e300, 1e300, 1e300, translate(1e300, 0, 0, sphere {})))"),
-            "t.ray:2:51: error: transform overflows (the accumulated matrix is not finite)");
+  EXPECT_EQ(error("translate(1e15, 0, 0, scale(1e15, 1e15, 1e15, translate(1e15, 0, 0, sphere {})))"),
+            "t.ray:2:47: error: transform overflows (an entry of the accumulated matrix exceeds 1e30)");
 }
 
 std::string repeat(const std::string& s, int n) {

@@ -581,6 +581,22 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   // Ids: leaves 0..n-1, merges n..2n-2, handed out in fixed blocks.
   std::vector<Cluster> clusters(2 * n - 1);
   for (size_t i = 0; i < n; ++i) clusters[i] = detail::leafCluster(lights.lights[indices[i]], indices[i]);
+  // Weights relative to the brightest light (luminance in double): the metric's sums and
+  // products stay finite whatever the power. Lights of 1e38 would otherwise give inf (or
+  // NaN from inf * 0) metrics, and the nearest-neighbour search never found a partner.
+  {
+    double maxLum = 0;
+    std::vector<double> lum(n);
+    for (size_t i = 0; i < n; ++i) {
+      const Vec3d& c = clusters[i].intensity;
+      lum[i] = 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z);
+      if (lum[i] > maxLum) maxLum = lum[i];
+    }
+    for (size_t i = 0; i < n; ++i) {
+      double w = maxLum > 0 && std::isfinite(maxLum) ? lum[i] / maxLum : 1.0;
+      clusters[i].weight = std::isfinite(w) && w >= 0 ? float(w) : 1.0f;
+    }
+  }
   if (n == 1) {
     detail::layoutTree(clusters, 0, tree);
     return tree;

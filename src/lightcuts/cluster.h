@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/rng.h"
@@ -17,7 +18,8 @@ struct Cluster {
   Vec3 axis;
   float cosHalfAngle = 1;
   float halfAngle = 0;  // acos(cosHalfAngle), cached for the metric
-  float weight = 0;     // luminance of the summed intensity: the metric's I
+  float weight = 0;     // luminance of the summed intensity, relative to the brightest light:
+                        // the metric's I (normalised so that sums cannot overflow)
   // Summed RGB intensity, in double: a tree's merges may form long chains (a bright light
   // absorbing millions of dim ones one by one), and a float sum along a chain loses the dim
   // ones. Stored in the node as float once summed. (`weight` stays a float sum: it steers
@@ -42,7 +44,7 @@ inline Cluster leafCluster(const Light& l, uint32_t index) {
   c.cosHalfAngle = hasCone ? 1.0f : -1.0f;
   c.halfAngle = hasCone ? 0.0f : kPi;
   c.intensity = Vec3d(l.intensity);
-  c.weight = luminance(l.intensity);
+  c.weight = luminance(l.intensity);  // buildAgglomerativeTree normalises it
   c.rep = index;
   return c;
 }
@@ -63,7 +65,7 @@ inline Cluster mergeClusters(const Cluster& a, const Cluster& b, int32_t ia, int
     c.cosHalfAngle = -1;
     c.halfAngle = kPi;
   }
-  c.intensity = a.intensity + b.intensity;
+  c.intensity = a.intensity + b.intensity;  // in double: cannot overflow (clamped in the node)
   c.weight = a.weight + b.weight;
   uint64_t h = splitmix64(seed ^ (uint64_t(uint32_t(ia)) << 32 | uint32_t(ib)));
   double u = double(h >> 11) * 0x1p-53;
@@ -80,7 +82,8 @@ inline void setNodeFromCluster(LightNode& n, const Cluster& c) {
   n.axis = c.axis;
   n.cosHalfAngle = c.cosHalfAngle;
   n.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - c.cosHalfAngle * c.cosHalfAngle));
-  n.intensity = c.intensity.toFloat();
+  // Clamped: lights of huge power (sums beyond FLT_MAX) keep finite node intensities.
+  n.intensity = vmin(c.intensity.toFloat(), Color(std::numeric_limits<float>::max()));
   n.rep = c.rep;
   n.left = 0;
 }

@@ -87,6 +87,8 @@ struct GroupKey {
   }
 };
 
+double lum(const Color& c) { return 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z); }
+
 }  // namespace
 
 void computeMoments(const LightSet& lights, LightTree& tree) {
@@ -114,7 +116,7 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
       m[i].centroid = l.type == LightType::Directional ? -l.direction : l.position;
       m[i].meanAxis = l.direction;
       Sums s;
-      s.w = luminance(n.intensity);
+      s.w = lum(n.intensity);
       s.n = 1;
       s.posU = Vec3d(m[i].centroid);
       s.axisU = Vec3d(m[i].meanAxis);
@@ -158,8 +160,8 @@ void computeSeedData(const LightSet& lights, LightTree& tree) {
   std::vector<float> spread(tree.nodes.size(), 0.0f);
   sd.assign(tree.nodes.size(), SeedNodeData{});
   auto chroma = [](const Color& c) {
-    float s = c.x + c.y + c.z;
-    return s > 0 ? c / s : Color(1.0f / 3);
+    double s = double(c.x) + c.y + c.z;  // in double: the float sum may overflow
+    return s > 0 ? Color(float(c.x / s), float(c.y / s), float(c.z / s)) : Color(1.0f / 3);
   };
   for (size_t i = tree.nodes.size(); i-- > 0;) {
     const LightNode& n = tree.nodes[i];
@@ -174,9 +176,10 @@ void computeSeedData(const LightSet& lights, LightTree& tree) {
     const SeedNodeData& da = sd[n.left];
     const SeedNodeData& db = sd[n.left + 1];
     d.direction = length2(mo.meanAxis) > 0 ? normalize(mo.meanAxis) : da.direction;
-    float wa = luminance(tree.nodes[n.left].intensity), wb = luminance(tree.nodes[n.left + 1].intensity);
-    float w = wa + wb;
-    if (!(w > 0)) { wa = wb = 0.5f; w = 1; }
+    // Relative weights (in double: luminances near FLT_MAX would overflow their sum).
+    double la = lum(tree.nodes[n.left].intensity), lb = lum(tree.nodes[n.left + 1].intensity);
+    float wa = 0.5f, wb = 0.5f, w = 1;
+    if (la + lb > 0) wa = float(la / (la + lb)), wb = float(lb / (la + lb));
     float meanDist = (wa * (da.error / (1 + spread[n.left]) + length(da.position - d.position)) +
                       wb * (db.error / (1 + spread[n.left + 1]) + length(db.position - d.position))) / w;
     Color cm = chroma(n.intensity);

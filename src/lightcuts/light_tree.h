@@ -12,6 +12,8 @@
 // One tree per (light type, light group): clusters never mix attenuation or falloff.
 #pragma once
 
+#include <limits>
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -95,12 +97,15 @@ const char* treeBuilderName(TreeBuilder b);
 // Smallest cone containing both cones (pbrt-v4's DirectionCone union).
 void coneUnion(const Vec3& a, float cosA, const Vec3& b, float cosB, Vec3& axis, float& cosOut);
 
-// The agglomerative metric of a cluster: I * (diag^2 + c^2 (1 - cos beta)^2).
+// The agglomerative metric of a cluster: I * (diag^2 + c^2 (1 - cos beta)^2). Computed in
+// double and clamped to the largest float, so that huge intensities or extents give a
+// large finite value rather than inf (or NaN from inf * 0).
 inline float clusterMetric(float intensity, const Vec3& lo, const Vec3& hi, float cosHalfAngle,
                            float c) {
-  Vec3 e = hi - lo;
-  float a = 1 - cosHalfAngle;
-  return intensity * (dot(e, e) + c * c * a * a);
+  double ex = double(hi.x) - lo.x, ey = double(hi.y) - lo.y, ez = double(hi.z) - lo.z;
+  double a = 1 - double(cosHalfAngle), cc = double(c);
+  double m = double(intensity) * (ex * ex + ey * ey + ez * ez + cc * cc * a * a);
+  return m >= double(std::numeric_limits<float>::max()) ? std::numeric_limits<float>::max() : float(m);
 }
 
 // Builders over a list of light indices of one type and group (used by buildLightForest).

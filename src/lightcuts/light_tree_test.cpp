@@ -5,7 +5,13 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
+#include <future>
+#include <memory>
+#include <thread>
 #include <set>
 
 #include "core/rng.h"
@@ -199,6 +205,52 @@ TEST(SeedBuild, ErrorIsWeightedMeanDistanceToCentroid) {
   LightForest f = buildLightForest(set, TreeBuildOptions{TreeBuilder::Seed, 1});
   EXPECT_FLOAT_EQ(f.trees[0].seed[0].error, 1.0f);  // same colour: no spread factor
   EXPECT_EQ(f.trees[0].seed[0].position, Vec3(1, 0, 0));
+}
+
+// Issue 23: lights of huge but finite power (2e38: the sums overflow a float) used to make the
+// agglomerative metric inf or NaN, and the build never finished. It must finish at once and
+// give a valid tree whose node intensities stay finite.
+TEST(TreeBuild, HugeIntensitiesBuildQuicklyAndStayFinite) {
+  for (LightType type : {LightType::Omni, LightType::Oriented}) {
+    for (size_t exactLimit : {size_t(0), size_t(8192), size_t(64)}) {
+      LightSet set = randomLights(300, type, 7);
+      for (size_t i = 0; i < set.lights.size(); ++i) {
+        set.lights[i].intensity = Color(2e38f, 2e38f, i % 3 == 0 ? 3e38f : 0.0f);
+        if (i % 2) set.lights[i].position = set.lights[i - 1].position;  // co-located pairs
+      }
+      auto done = std::make_shared<std::promise<LightForest>>();
+      std::future<LightForest> result = done->get_future();
+      TreeBuildOptions o;
+      o.exactLimit = exactLimit == 0 ? 8192 : exactLimit;
+      if (exactLimit == 0) o.builder = TreeBuilder::Seed;  // the other builder too
+      std::thread([done, set, o] { done->set_value(buildLightForest(set, o)); }).detach();
+      if (result.wait_for(std::chrono::seconds(1)) != std::future_status::ready) {
+        std::fprintf(stderr, "the tree build over lights of 2e38 did not finish within a second\n");
+        std::_Exit(1);  // the builder thread cannot be stopped
+      }
+      LightForest f = result.get();
+      ASSERT_EQ(f.trees.size(), 1u);
+      const LightTree& t = f.trees[0];
+      EXPECT_EQ(t.nodes.size(), 2 * set.lights.size() - 1);
+      std::set<uint32_t> leaves;
+      for (const LightNode& n : t.nodes) {
+        EXPECT_TRUE(isFinite(n.intensity));
+        EXPECT_TRUE(isFinite(n.lo) && isFinite(n.hi));
+        if (n.isLeaf()) {
+          EXPECT_TRUE(leaves.insert(n.rep).second);
+        }
+      }
+      EXPECT_EQ(leaves.size(), set.lights.size());
+    }
+  }
+}
+
+// The metric itself does not overflow for huge intensities or extents.
+TEST(Agglomerative, ClusterMetricIsFiniteForHugeValues) {
+  float m = clusterMetric(3e38f, Vec3(-1e15f), Vec3(1e15f), -1, 1e15f);
+  EXPECT_TRUE(std::isfinite(m));
+  EXPECT_GT(m, 0);
+  EXPECT_EQ(clusterMetric(3e38f, Vec3(1), Vec3(1), 1, 1), 0);
 }
 
 TEST(Nodes, AreCompact) { EXPECT_LE(sizeof(LightNode), 64u); }

@@ -22,8 +22,8 @@ namespace {
 using detail::Cluster;
 
 Color chromaticity(const Color& c) {
-  float s = c.x + c.y + c.z;
-  return s > 0 ? c / s : Color(1.0f / 3);
+  double s = double(c.x) + c.y + c.z;  // in double: the float sum may overflow
+  return s > 0 ? Color(float(c.x / s), float(c.y / s), float(c.z / s)) : Color(1.0f / 3);
 }
 
 struct SeedBuilder {
@@ -86,22 +86,25 @@ struct SeedBuilder {
   // The seed's per-node error over idx[b, e), exactly.
   // Sums in double: the root's run over every light.
   float nodeError(size_t b, size_t e) const {
-    double w = 0;
-    Vec3d centroidSum, cSum;
+    // In double: luminances of huge lights would overflow float sums.
+    double w = 0, cx = 0, cy = 0, cz = 0, sr = 0, sg = 0, sb = 0;
+    auto lum = [](const Color& c) { return 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z); };
     for (size_t i = b; i < e; ++i) {
       const Light& l = lights.lights[idx[i]];
-      float li = luminance(l.intensity);
+      double li = lum(l.intensity);
+      Vec3 p = point(idx[i]);
       w += li;
-      centroidSum += Vec3d(point(idx[i])) * li;
-      cSum += l.intensity;
+      cx += p.x * li, cy += p.y * li, cz += p.z * li;
+      sr += l.intensity.x, sg += l.intensity.y, sb += l.intensity.z;
     }
     if (!(w > 0)) return 0;
-    Vec3 centroid = (centroidSum / w).toFloat();
-    Color cm = chromaticity(cSum.toFloat());
+    Vec3 centroid(float(cx / w), float(cy / w), float(cz / w));
+    double smax = std::max({sr, sg, sb, 1e-300});
+    Color cm = chromaticity(Color(float(sr / smax), float(sg / smax), float(sb / smax)));
     double dist = 0, spread = 0;
     for (size_t i = b; i < e; ++i) {
       const Light& l = lights.lights[idx[i]];
-      float li = luminance(l.intensity);
+      double li = lum(l.intensity);
       dist += li * length(point(idx[i]) - centroid);
       Vec3 d = vabs(chromaticity(l.intensity) - cm);
       spread += li * (d.x + d.y + d.z);

@@ -238,8 +238,11 @@ struct Tracer {
     if (depth >= maxDepth) return L;
     if (!isBlack(m.kr)) {
       Vec3 r = normalize(reflect(v, h.ns));
-      ++secondaryRays;
-      L += m.kr * trace(Ray{scene.offsetOrigin(h, r), r, 0, kInf}, depth + 1);
+      // A non-finite direction (NaN normal, extreme values) is dropped, not traced.
+      if (isFinite(r)) {
+        ++secondaryRays;
+        L += m.kr * trace(Ray{scene.offsetOrigin(h, r), r, 0, kInf}, depth + 1);
+      }
     }
     if (!isBlack(m.kt)) {
       // Entering through the front face goes from air (index 1) into the material.
@@ -247,13 +250,17 @@ struct Tracer {
       float cosI = std::min(1.0f, dot(v, h.ns));
       float sin2T = eta * eta * (1 - cosI * cosI);
       Vec3 t;
-      if (sin2T >= 1) {
+      // (written so that a NaN sin2T, e.g. inf * 0 for a huge index, is total reflection)
+      if (!(sin2T < 1)) {
         t = normalize(reflect(v, h.ns));  // total internal reflection
       } else {
         t = normalize(-v * eta + h.ns * (eta * cosI - std::sqrt(1 - sin2T)));
       }
-      ++secondaryRays;
-      L += m.kt * trace(Ray{scene.offsetOrigin(h, t), t, 0, kInf}, depth + 1);
+      // A refracted ray with a non-finite direction is dropped, not traced.
+      if (isFinite(t)) {
+        ++secondaryRays;
+        L += m.kt * trace(Ray{scene.offsetOrigin(h, t), t, 0, kInf}, depth + 1);
+      }
     }
     return L;
   }

@@ -239,5 +239,29 @@ TEST(Renderer, CancelledRenderIsMarkedInterrupted) {
   EXPECT_TRUE(r.interrupted);
 }
 
+// Issue 23: a refractive index so large that refraction gives a NaN direction (inf * 0),
+// and geometry so far away that hit points lie beyond what Embree accepts as a ray origin
+// (~1.8e18), used to abort in Embree (ray.valid()). Such rays are dropped, not traced.
+TEST(Robustness, HugeIndexAndFarHitPointsDoNotReachEmbree) {
+  io::SceneDesc d = io::parseRayString(R"(SBT-raytracer 1.0
+camera { position = (0, 0, 4); }
+point_light { position = (0, 2, 4); }
+sphere { material = { diffuse = (0.5, 0.5, 0.5); transmissive = (1, 1, 1); reflective = (0.5, 0.5, 0.5); index = 1.5; }; }
+)", "test.ray", "");
+  for (auto& m : d.materials) m.index.value = 1e20f;  // beyond what the parser accepts
+  auto s = scene::Scene::build(d);
+  RenderResult r = renderBrute(*s, 8, 8);
+  for (const Color& c : r.image.pixels) EXPECT_TRUE(isFinite(c)) << c.x;
+
+  // A mirror sphere of radius 1e30 around the camera: every hit point is ~1e30 away.
+  auto far = sceneFrom(R"(SBT-raytracer 1.0
+camera { position = (0, 0, 0); }
+point_light { position = (0, 2, 0); }
+scale(1e15, scale(1e15, sphere { material = { diffuse = (0.5, 0.5, 0.5); reflective = (0.5, 0.5, 0.5); }; }))
+)");
+  RenderResult f = renderBrute(*far, 8, 8);
+  for (const Color& c : f.image.pixels) EXPECT_TRUE(isFinite(c)) << c.x;
+}
+
 }  // namespace
 }  // namespace lc::render

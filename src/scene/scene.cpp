@@ -85,6 +85,16 @@ TexScalar resolveScalar(const io::ScalarParam& p, TextureCache& cache, const Bui
   return s;
 }
 
+// Embree asserts (RTCRay::valid) that origin and direction lie within +-1.844e18 and that
+// tnear/tfar are not NaN. Rays that fail this (from huge or non-finite geometry, or a
+// degenerate refraction) are not traced: they hit nothing and light is treated as blocked.
+bool rayIsValid(const Vec3& o, const Vec3& d, float tnear, float tfar) {
+  constexpr float kLarge = 1.8e18f;
+  auto ok = [&](float x) { return std::fabs(x) <= kLarge; };  // false for NaN and inf
+  return ok(o.x) && ok(o.y) && ok(o.z) && ok(d.x) && ok(d.y) && ok(d.z) && tnear >= 0 &&
+         !std::isnan(tfar);
+}
+
 // A closest-hit query from o along d over [tnear, tfar], no hit yet.
 RTCRayHit rayHit(const Vec3& o, const Vec3& d, float tnear, float tfar) {
   RTCRayHit rh;
@@ -325,6 +335,7 @@ size_t Scene::triangleCount() const {
 
 bool Scene::intersect(const Ray& ray, Hit& hit) const {
   RTCIntersectContext ctx;
+  if (!rayIsValid(ray.o, ray.d, ray.tmin, ray.tmax)) return false;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh = rayHit(ray.o, ray.d, ray.tmin, ray.tmax);
   rtcIntersect1(rtc_, &ctx, &rh);
@@ -374,6 +385,7 @@ bool Scene::intersect(const Ray& ray, Hit& hit) const {
 }
 
 bool Scene::occluded(const Vec3& origin, const Vec3& dir, float tmax) const {
+  if (!rayIsValid(origin, dir, 0, tmax)) return true;
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   RTCRay r;
@@ -391,6 +403,7 @@ bool Scene::occluded(const Vec3& origin, const Vec3& dir, float tmax) const {
 
 int Scene::firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t) const {
   RTCIntersectContext ctx;
+  if (!rayIsValid(origin, dir, 0, tmax)) return -1;
   rtcInitIntersectContext(&ctx);
   RTCRayHit rh = rayHit(origin, dir, 0, tmax);
   rtcIntersect1(rtc_, &ctx, &rh);

@@ -23,9 +23,9 @@ std::shared_ptr<const Texture> Texture::load(const std::string& path, bool srgb,
     // Reword readImage's messages so the user sees that a texture was being read.
     switch (e.kind) {
       case io::ImageReadError::Kind::Open:
-        throw Error("cannot open texture '" + path + "': " + e.reason);
+        throw Error("cannot open texture " + quoteInput(path) + ": " + e.reason);
       case io::ImageReadError::Kind::TooLarge:
-        throw Error("texture '" + path + "' is " + std::to_string(e.width) + "x" +
+        throw Error("texture " + quoteInput(path) + " is " + std::to_string(e.width) + "x" +
                     std::to_string(e.height) + " = " +
                     std::to_string(uint64_t(e.width) * uint64_t(e.height)) +
                     " pixels, more than --max-texture-pixels (" +
@@ -33,7 +33,7 @@ std::shared_ptr<const Texture> Texture::load(const std::string& path, bool srgb,
       case io::ImageReadError::Kind::Decode:
         break;
     }
-    throw Error("cannot read texture '" + path + "': " + e.reason);
+    throw Error("cannot read texture " + quoteInput(path) + ": " + e.reason);
   }
 }
 
