@@ -133,6 +133,7 @@ class Lightcuts final : public LightEvaluator {
     ShadowResult shadow;  // what the representative's shadow ray found
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
     bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
+    bool probeable;   // large enough for the visibility probes (kProbeMinLights)
   };
 
   static uint64_t heapKey(float bound, uint32_t index) {
@@ -259,8 +260,13 @@ class Lightcuts final : public LightEvaluator {
       float b = luminance(upper);
       if (b > 0) {
         // A node in the heap may be refined next: fetch its children while we work.
+        // Its children's light counts too: a cache miss on every refinement otherwise.
         __builtin_prefetch(&tree.nodes[n.left]);
         __builtin_prefetch(&tree.nodes[n.left + 1]);
+        if (probes) {
+          __builtin_prefetch(&tree.moments[n.left]);
+          __builtin_prefetch(&tree.moments[n.left + 1]);
+        }
         const float lo = luminance(lower);
         float spread = visible && !boundary ? std::max(0.0f, b - lo) : b;
         // Where the contribution is smooth over the cluster and its representative is
@@ -272,7 +278,8 @@ class Lightcuts final : public LightEvaluator {
         const bool scaled = rss && fo && !boundary;
         (scaled ? sumScaled : sumSq) += double(spread) * spread;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
-        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, fo, scaled});
+        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, fo, scaled,
+                                probes && tree.moments[ni].lights >= kProbeMinLights});
       } else if (record) {
         record1(t, ni, found, false);
       }
@@ -305,7 +312,7 @@ class Lightcuts final : public LightEvaluator {
       sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
       const LightTree& tree = forest_.trees[cn.tree];
       const LightGroup& g = lights_.groups[tree.group];
-      if (probes && cn.shadow.blocker >= 0 && tree.moments[cn.node].lights >= kProbeMinLights &&
+      if (cn.probeable && cn.shadow.blocker >= 0 &&
           hiddenCluster(tree.nodes[cn.node], tree.type, sp, cn.shadow, vis, stats)) {
         // Its representative is hidden, and so is the whole cluster: it stays in the cut,
         // exactly 0, instead of being refined down to its lights.
