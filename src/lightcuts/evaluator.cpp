@@ -422,7 +422,20 @@ class Lightcuts final : public LightEvaluator {
 class SeedCuts final : public LightEvaluator {
  public:
   SeedCuts(const LightSet& lights, const LightForest& forest, const CutOptions& o)
-      : lights_(lights), forest_(forest), opt_(o) {}
+      : lights_(lights), forest_(forest), opt_(o) {
+    // Trees without the seed's traversal data (agglomerative ones) get it here, once.
+    seed_.resize(forest.trees.size());
+    owned_.reserve(forest.trees.size());
+    for (size_t t = 0; t < forest.trees.size(); ++t) {
+      const LightTree& tree = forest.trees[t];
+      if (tree.seed.size() == tree.nodes.size()) {
+        seed_[t] = tree.seed.data();
+      } else {
+        owned_.push_back(seedNodeData(tree));
+        seed_[t] = owned_.back().data();
+      }
+    }
+  }
 
   EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const override {
     static thread_local std::vector<std::pair<uint32_t, uint32_t>> stack;
@@ -438,7 +451,7 @@ class SeedCuts final : public LightEvaluator {
       const LightGroup& g = lights_.groups[tree.group];
       const LightNode& n = tree.nodes[ni];
       if (!n.isLeaf()) {
-        const SeedNodeData& sd = tree.seed[ni];
+        const SeedNodeData& sd = seed_[t][ni];
         float dist = tree.type == LightType::Directional ? 1.0f : length(sp.p - sd.position);
         if (sd.error > opt_.errorRatio * dist && cutSize + stack.size() + 2 <= uint32_t(opt_.maxCut)) {
           stack.emplace_back(t, n.left);
@@ -447,13 +460,13 @@ class SeedCuts final : public LightEvaluator {
         }
       }
       bool blocked = false;
-      Color c = nodeLight(tree, g, ni, sp, vis, stats, blocked);
+      Color c = nodeLight(tree, seed_[t], g, ni, sp, vis, stats, blocked);
       if (blocked) {
         // The seed's fallback: a blocked representative may hide lights that are visible;
         // its two children (one level only) stand in for it.
         for (uint32_t k = n.left; k <= n.left + 1; ++k) {
           bool unused;
-          total += nodeLight(tree, g, k, sp, vis, stats, unused);
+          total += nodeLight(tree, seed_[t], g, k, sp, vis, stats, unused);
         }
         cutSize += 2;
         continue;
@@ -470,13 +483,13 @@ class SeedCuts final : public LightEvaluator {
   // The contribution of a node's light: the light itself at a leaf, the synthetic
   // centroid light otherwise (its visibility measured toward the node's representative
   // light). `blocked` is set when an inner node's light is non-zero but fully occluded.
-  Color nodeLight(const LightTree& tree, const LightGroup& g, uint32_t ni, const ShadingPoint& sp,
-                  Visibility& vis, EvalStats& stats, bool& blocked) const {
+  Color nodeLight(const LightTree& tree, const SeedNodeData* seed, const LightGroup& g, uint32_t ni,
+                  const ShadingPoint& sp, Visibility& vis, EvalStats& stats, bool& blocked) const {
     const LightNode& n = tree.nodes[ni];
     blocked = false;
     ShadowResult found;
     if (n.isLeaf()) return shadowedUnit(lights_.lights[n.rep], g, sp, vis, stats, found) * n.intensity;
-    const SeedNodeData& sd = tree.seed[ni];
+    const SeedNodeData& sd = seed[ni];
     Light syn;
     syn.type = tree.type;
     syn.group = tree.group;
@@ -502,6 +515,8 @@ class SeedCuts final : public LightEvaluator {
   const LightSet& lights_;
   const LightForest& forest_;
   CutOptions opt_;
+  std::vector<const SeedNodeData*> seed_;  // per tree: its own or owned_'s
+  std::vector<std::vector<SeedNodeData>> owned_;
 };
 
 }  // namespace

@@ -150,13 +150,16 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
 }
 
 void computeSeedData(const LightSet& lights, LightTree& tree) {
-  // Bottom-up, as computeMoments. The mean distance to the centroid is exact for leaves and
+  if (tree.moments.size() != tree.nodes.size()) computeMoments(lights, tree);
+  tree.seed = seedNodeData(tree);
+}
+
+std::vector<SeedNodeData> seedNodeData(const LightTree& tree) {
+  // Bottom-up, from the moments. The mean distance to the centroid is exact for leaves and
   // bounded above through the triangle inequality for inner nodes; the seed builder
   // overwrites it with exact values.
-  if (tree.moments.size() != tree.nodes.size()) computeMoments(lights, tree);
-  std::vector<SeedNodeData>& sd = tree.seed;
+  std::vector<SeedNodeData> sd(tree.nodes.size(), SeedNodeData{});
   std::vector<float> spread(tree.nodes.size(), 0.0f);
-  sd.assign(tree.nodes.size(), SeedNodeData{});
   auto chroma = [](const Color& c) {
     float s = c.x + c.y + c.z;
     return s > 0 ? c / s : Color(1.0f / 3);
@@ -184,6 +187,7 @@ void computeSeedData(const LightSet& lights, LightTree& tree) {
     spread[i] = (wa * (spread[n.left] + ca.x + ca.y + ca.z) + wb * (spread[n.left + 1] + cb.x + cb.y + cb.z)) / w;
     d.error = meanDist * (1 + spread[i]);
   }
+  return sd;
 }
 
 void computePreorder(LightTree& tree) {
@@ -238,7 +242,8 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
         }
       }
       t = buildAgglomerativeTree(lights, idx, k.type, c, seed, std::max<size_t>(options.exactLimit, 2), &progress);
-      computeSeedData(lights, t);
+      computeMoments(lights, t);
+      if (options.seedData) computeSeedData(lights, t);
     }
     computePreorder(t);
     t.type = k.type;

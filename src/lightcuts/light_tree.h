@@ -1,7 +1,9 @@
 // Light trees: binary trees of light clusters. Each node stores what the Lightcuts error
 // bounds need (bounding box, cone of light normals, summed intensity, a representative
-// light) and, in a parallel array, what the seed's traversal needs (intensity-weighted
-// centroid and direction, and its error radius).
+// light) and, in parallel arrays, the first moments and preorder positions that the
+// first-order estimate and the reconstruction cuts need. What the seed's traversal needs
+// (intensity-weighted centroid and direction, and its error radius) the seed builder
+// stores; for other trees the seed's evaluator computes it when it is made.
 //
 // Two builders:
 //   Agglomerative (Walter et al. 2005, built the fast way of Walter et al. 2008): greedily
@@ -55,7 +57,9 @@ struct LightTree {
   LightType type = LightType::Omni;
   uint16_t group = 0;
   std::vector<LightNode> nodes;  // nodes[0] is the root
-  std::vector<SeedNodeData> seed;  // parallel to nodes
+  // Parallel to nodes when filled: the seed builder fills it; agglomerative trees leave it
+  // empty (unless TreeBuildOptions::seedData) and makeSeedCuts computes it on demand.
+  std::vector<SeedNodeData> seed;
   std::vector<NodeMoments> moments;  // parallel to nodes
   // Parallel to nodes: each node's position in a depth-first walk that visits the left
   // child (n.left) before the right one, so a subtree is a contiguous range. Reconstruction
@@ -75,6 +79,9 @@ struct TreeBuildOptions {
   // the diagonal of the tree's own lights (for callers that know no scene).
   float sceneDiagonal = 0;
   ProgressFn progress = {};  // called with the share of lights clustered (core/progress.h)
+  // Agglomerative trees: fill LightTree::seed as well (56 bytes per light that only
+  // --method seed reads; makeSeedCuts computes the same data when it is missing).
+  bool seedData = false;
 };
 
 struct LightForest {
@@ -119,5 +126,7 @@ void computeMoments(const LightSet& lights, LightTree& tree);
 // Fills LightTree::seed from the finished nodes and their moments (centroids, mean
 // directions, errors).
 void computeSeedData(const LightSet& lights, LightTree& tree);
+// The same data, for a tree that has its moments, without touching the tree.
+std::vector<SeedNodeData> seedNodeData(const LightTree& tree);
 
 }  // namespace lc::lightcuts

@@ -74,7 +74,31 @@ TEST_P(TreeBuild, IsAValidClusterHierarchy) {
     LightForest f = buildLightForest(set, TreeBuildOptions{builder, 5});
     ASSERT_EQ(f.trees.size(), 1u);
     checkTree(set, f.trees[0]);
-    ASSERT_EQ(f.trees[0].seed.size(), f.trees[0].nodes.size());
+    ASSERT_EQ(f.trees[0].moments.size(), f.trees[0].nodes.size());
+    // Only the seed builder stores the seed's traversal data; others leave it to makeSeedCuts.
+    ASSERT_EQ(f.trees[0].seed.size(), builder == TreeBuilder::Seed ? f.trees[0].nodes.size() : 0u);
+  }
+}
+
+// The seed's traversal data that agglomerative trees no longer store: computed on demand,
+// it equals what the build used to store, field for field.
+TEST(TreeBuild, SeedDataOnDemandEqualsEager) {
+  for (LightType type : {LightType::Omni, LightType::Oriented, LightType::Directional}) {
+    LightSet set = randomLights(3000, type, 21, true);
+    TreeBuildOptions eager{TreeBuilder::Agglomerative, 5};
+    eager.seedData = true;
+    LightForest a = buildLightForest(set, eager);
+    LightForest b = buildLightForest(set, TreeBuildOptions{TreeBuilder::Agglomerative, 5});
+    ASSERT_EQ(a.trees[0].seed.size(), a.trees[0].nodes.size());
+    ASSERT_TRUE(b.trees[0].seed.empty());
+    EXPECT_LT(b.memoryBytes(), a.memoryBytes());
+    std::vector<SeedNodeData> lazy = seedNodeData(b.trees[0]);
+    ASSERT_EQ(lazy.size(), a.trees[0].seed.size());
+    for (size_t i = 0; i < lazy.size(); ++i) {
+      ASSERT_EQ(lazy[i].position, a.trees[0].seed[i].position) << i;
+      ASSERT_EQ(lazy[i].direction, a.trees[0].seed[i].direction) << i;
+      ASSERT_EQ(lazy[i].error, a.trees[0].seed[i].error) << i;
+    }
   }
 }
 
