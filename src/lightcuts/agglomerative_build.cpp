@@ -37,6 +37,21 @@ namespace {
 
 using detail::Cluster;
 
+// The clusters of one build by id: leaves (0..n-1) made from their lights when asked, so
+// that only the n - 1 merges (n..2n-2) take memory (88 bytes each).
+struct ClusterStore {
+  const LightSet& lights;
+  const std::vector<uint32_t>& indices;
+  std::vector<Cluster> merged;  // id n + k at k
+
+  size_t leaves() const { return indices.size(); }
+  Cluster get(int32_t id) const {
+    size_t i = size_t(id);
+    return i < leaves() ? detail::leafCluster(lights.lights[indices[i]], indices[i]) : merged[i - leaves()];
+  }
+  Cluster& mergedAt(int32_t id) { return merged[size_t(id) - leaves()]; }
+};
+
 constexpr int kLeafSize = 4;
 
 // A cluster as the k-d leaves hold it: compact and contiguous, so a leaf scan touches one
@@ -102,7 +117,7 @@ class AgglomerativeBuilder {
 
   // Clusters `ids` (indices into `all`) until `target` remain. Appends the merged clusters,
   // with children as global ids, to `created` and returns the global ids of the survivors.
-  std::vector<int32_t> reduce(const std::vector<Cluster>& all, const std::vector<int32_t>& ids,
+  std::vector<int32_t> reduce(const ClusterStore& all, const std::vector<int32_t>& ids,
                               size_t target, int32_t idBase, std::vector<Cluster>& created,
                               bool parallelQueries) {
     size_t n = ids.size();
@@ -112,7 +127,7 @@ class AgglomerativeBuilder {
     global_.clear();
     global_.reserve(2 * n);
     for (int32_t g : ids) {
-      cl_.push_back(all[size_t(g)]);
+      cl_.push_back(all.get(g));
       global_.push_back(g);
     }
     slotOf_.assign(2 * n, -1);
@@ -410,7 +425,7 @@ class ApproximateClustering {
   static constexpr size_t kGroup = 20;  // delta: lights per bottom group
   static constexpr double kAlpha = 0.4;
 
-  ApproximateClustering(std::vector<Cluster>& all, bool withCone, float coneWeight, uint64_t seed)
+  ApproximateClustering(ClusterStore& all, bool withCone, float coneWeight, uint64_t seed)
       : all_(all), withCone_(withCone), c2_(coneWeight * coneWeight), seed_(seed) {}
 
   // Clusters kept by a group of n: f(n) = c n^alpha with f(delta) = delta / 2.
@@ -496,9 +511,13 @@ class ApproximateClustering {
     const size_t stride = m;
     static thread_local std::vector<float> dm;
     dm.resize(m * m);
+    // The set's clusters, copied: leaves are made from their lights once, not per pair.
+    static thread_local std::vector<Cluster> cs;
+    cs.resize(m);
+    for (size_t i = 0; i < m; ++i) cs[i] = all_.get(set[i]);
     auto D = [&](size_t i, size_t j) -> float& { return dm[i * stride + j]; };
     for (size_t i = 0; i < m; ++i)
-      for (size_t j = i + 1; j < m; ++j) metricPair(all_[size_t(set[i])], all_[size_t(set[j])], D(i, j), D(j, i));
+      for (size_t j = i + 1; j < m; ++j) metricPair(cs[i], cs[j], D(i, j), D(j, i));
     std::vector<float> nnD(m, kInf);
     std::vector<int32_t> nn(m, -1);
     auto refresh = [&](size_t i) {
@@ -521,13 +540,14 @@ class ApproximateClustering {
         if (nnD[k] < nnD[i]) i = k;
       size_t j = size_t(nn[i]);
       int32_t id = next++;
-      all_[size_t(id)] = detail::mergeClusters(all_[size_t(set[i])], all_[size_t(set[j])], set[i], set[j],
-                                               withCone_, seed_);
+      cs[i] = detail::mergeClusters(cs[i], cs[j], set[i], set[j], withCone_, seed_);
+      all_.mergedAt(id) = cs[i];
       // The merged cluster takes i's place; the last one moves into j's (its row and
       // column with it).
       set[i] = id;
       size_t last = m - 1;
       set[j] = set[last];
+      cs[j] = cs[last];
       nnD[j] = nnD[last];
       nn[j] = nn[last];
       if (j != last)
@@ -542,7 +562,7 @@ class ApproximateClustering {
       if (i == last) i = j;
       for (size_t k = 0; k < m; ++k) {
         if (k == i) continue;
-        metricPair(all_[size_t(set[i])], all_[size_t(set[k])], D(i, k), D(k, i));
+        metricPair(cs[i], cs[k], D(i, k), D(k, i));
       }
       refresh(i);
       for (size_t k = 0; k < m; ++k) {
@@ -560,7 +580,7 @@ class ApproximateClustering {
     }
   }
 
-  std::vector<Cluster>& all_;
+  ClusterStore& all_;
   bool withCone_;
   float c2_;
   uint64_t seed_;
@@ -579,10 +599,10 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   size_t n = indices.size();
   bool withCone = (type == LightType::Oriented || type == LightType::Spot) && coneWeight > 0;
   // Ids: leaves 0..n-1, merges n..2n-2, handed out in fixed blocks.
-  std::vector<Cluster> clusters(2 * n - 1);
-  for (size_t i = 0; i < n; ++i) clusters[i] = detail::leafCluster(lights.lights[indices[i]], indices[i]);
+  ClusterStore clusters{lights, indices, std::vector<Cluster>(n - 1)};
+  auto get = [&](int32_t id) { return clusters.get(id); };
   if (n == 1) {
-    detail::layoutTree(clusters, 0, tree);
+    detail::layoutTree(get, 1, 0, tree);
     return tree;
   }
 
@@ -592,9 +612,10 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
     for (size_t i = 0; i < n; ++i) top.push_back(int32_t(i));
   } else {
     Bounds3 b;
-    for (size_t i = 0; i < n; ++i) b.extend(clusters[i].lo);
+    auto point = [&](size_t i) { return detail::clusterPoint(lights.lights[indices[i]]); };
+    for (size_t i = 0; i < n; ++i) b.extend(point(i));
     std::vector<std::pair<uint32_t, int32_t>> keyed(n);
-    tbb::parallel_for(size_t(0), n, [&](size_t i) { keyed[i] = {mortonCode(clusters[i].lo, b), int32_t(i)}; });
+    tbb::parallel_for(size_t(0), n, [&](size_t i) { keyed[i] = {mortonCode(point(i), b), int32_t(i)}; });
     tbb::parallel_sort(keyed.begin(), keyed.end());
     std::vector<int32_t> order(n);
     for (size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
@@ -621,8 +642,8 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   std::vector<Cluster> created;
   AgglomerativeBuilder builder(withCone, coneWeight, seed);
   std::vector<int32_t> root = builder.reduce(clusters, top, 1, nextId, created, true);
-  std::copy(created.begin(), created.end(), clusters.begin() + nextId);
-  detail::layoutTree(clusters, root[0], tree);
+  std::copy(created.begin(), created.end(), clusters.merged.begin() + (nextId - int32_t(n)));
+  detail::layoutTree(get, 2 * n - 1, root[0], tree);
   if (progress) progress->add(n <= exactLimit ? double(n) : (1 - kChunkShare) * double(n));
   return tree;
 }

@@ -86,15 +86,17 @@ inline void setNodeFromCluster(LightNode& n, const Cluster& c) {
 }
 
 // Lays the cluster tree under `root` out as LightNodes: root first, siblings adjacent.
-inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, LightTree& tree) {
+// `get(id)` returns cluster id (by value or reference); `count` bounds the node count.
+template <class Get>
+void layoutTree(const Get& get, size_t count, int32_t root, LightTree& tree) {
   tree.nodes.clear();
-  tree.nodes.reserve(clusters.size());
+  tree.nodes.reserve(count);
   tree.nodes.push_back(LightNode{});
   std::vector<std::pair<int32_t, uint32_t>> stack{{root, 0u}};
   while (!stack.empty()) {
     auto [ci, ni] = stack.back();
     stack.pop_back();
-    const Cluster& c = clusters[size_t(ci)];
+    const Cluster& c = get(ci);
     setNodeFromCluster(tree.nodes[ni], c);
     if (c.left >= 0) {
       uint32_t j = uint32_t(tree.nodes.size());
@@ -105,6 +107,10 @@ inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, Light
       stack.emplace_back(c.left, j);
     }
   }
+}
+
+inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, LightTree& tree) {
+  layoutTree([&](int32_t id) -> const Cluster& { return clusters[size_t(id)]; }, clusters.size(), root, tree);
 }
 
 }  // namespace lc::lightcuts::detail
