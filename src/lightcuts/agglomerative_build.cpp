@@ -50,6 +50,7 @@ struct ClusterStore {
     return i < leaves() ? detail::leafCluster(lights.lights[indices[i]], indices[i]) : merged[i - leaves()];
   }
   Cluster& mergedAt(int32_t id) { return merged[size_t(id) - leaves()]; }
+  uint32_t count(int32_t id) const { return size_t(id) < leaves() ? 1u : merged[size_t(id) - leaves()].count; }
 };
 
 constexpr int kLeafSize = 4;
@@ -397,6 +398,155 @@ class AgglomerativeBuilder {
   size_t aliveAtBuild_ = 0;
 };
 
+
+// The layout of detail::layoutTree, the moments of computeMoments and the preorder of
+// computePreorder in one pass over the clusters, the subtrees below the top levels in
+// parallel. Node numbers and preorder positions follow from the clusters' light counts:
+// the node taken at preorder position p that has k inner nodes before it in preorder puts
+// its children at 1 + 2k; a left child follows its parent in preorder, a right one follows
+// the left subtree's 2 count - 1 nodes. Moments are summed as computeMoments does (each
+// node's sums = left's + right's, in double), so every value is the same bit for bit.
+struct MomentSums {
+  double w = 0, n = 0;
+  Vec3d pos, axis;    // sum of w x, sum of w n
+  Vec3d posU, axisU;  // unweighted sums
+  void add(const MomentSums& b) {
+    w += b.w;
+    n += b.n;
+    pos += b.pos;
+    axis += b.axis;
+    posU += b.posU;
+    axisU += b.axisU;
+  }
+};
+
+struct LayoutItem {
+  int32_t cluster;
+  uint32_t node, innerBefore, pre;
+};
+
+class TreeWriter {
+ public:
+  TreeWriter(const ClusterStore& clusters, LightTree& tree) : cl_(clusters), tree_(tree) {}
+
+  void run(int32_t root) {
+    size_t total = 2 * cl_.leaves() - 1;
+    tree_.nodes.resize(total);
+    tree_.moments.resize(total);
+    tree_.preorder.resize(total);
+    // Top levels serially, down to subtrees of at most kTask lights; those in parallel.
+    constexpr uint32_t kTask = 1u << 14;
+    std::vector<LayoutItem> tasks;
+    std::unordered_map<uint32_t, uint32_t> taskOf;  // node -> task
+    std::vector<LayoutItem> stack{{root, 0, 0, 0}};
+    while (!stack.empty()) {
+      LayoutItem it = stack.back();
+      stack.pop_back();
+      Cluster c = cl_.get(it.cluster);
+      if (c.left < 0 || c.count <= kTask) {
+        taskOf.emplace(it.node, uint32_t(tasks.size()));
+        tasks.push_back(it);
+        continue;
+      }
+      uint32_t leftCount = cl_.count(c.left);
+      writeInner(it, c);
+      stack.push_back(LayoutItem{c.right, 2 * it.innerBefore + 2, it.innerBefore + leftCount,
+                                 it.pre + 2 * leftCount});
+      stack.push_back(LayoutItem{c.left, 2 * it.innerBefore + 1, it.innerBefore + 1, it.pre + 1});
+    }
+    std::vector<MomentSums> taskSums(tasks.size());
+    tbb::parallel_for(size_t(0), tasks.size(), [&](size_t k) { taskSums[k] = subtree(tasks[k]); });
+    // The top levels' moments: computeMoments' walk, a task's root standing for its subtree.
+    std::vector<std::pair<uint32_t, bool>> walk{{0u, false}};
+    std::vector<MomentSums> done;
+    while (!walk.empty()) {
+      auto [i, expanded] = walk.back();
+      walk.pop_back();
+      auto t = taskOf.find(i);
+      if (t != taskOf.end()) {
+        done.push_back(taskSums[t->second]);
+        continue;
+      }
+      const LightNode& n = tree_.nodes[i];
+      if (!expanded) {
+        walk.emplace_back(i, true);
+        walk.emplace_back(n.left + 1, false);
+        walk.emplace_back(n.left, false);
+        continue;
+      }
+      MomentSums b = done.back();
+      done.pop_back();
+      done.back().add(b);
+      setMeans(i, done.back());
+    }
+  }
+
+ private:
+  void writeInner(const LayoutItem& it, const Cluster& c) {
+    LightNode& n = tree_.nodes[it.node];
+    detail::setNodeFromCluster(n, c);
+    n.left = 2 * it.innerBefore + 1;
+    tree_.preorder[it.node] = it.pre;
+    tree_.moments[it.node].lights = c.count;
+  }
+
+  void setMeans(uint32_t i, const MomentSums& s) {
+    NodeMoments& m = tree_.moments[i];
+    if (s.w > 0) {
+      m.centroid = (s.pos / s.w).toFloat();
+      m.meanAxis = (s.axis / s.w).toFloat();
+    } else {
+      m.centroid = (s.posU / s.n).toFloat();
+      m.meanAxis = (s.axisU / s.n).toFloat();
+    }
+  }
+
+  // One subtree, depth first with explicit stacks (chains of merges can be deep).
+  MomentSums subtree(const LayoutItem& top) {
+    std::vector<std::pair<LayoutItem, bool>> stack{{top, false}};
+    std::vector<MomentSums> done;
+    while (!stack.empty()) {
+      auto [it, expanded] = stack.back();
+      stack.pop_back();
+      if (expanded) {
+        MomentSums b = done.back();
+        done.pop_back();
+        done.back().add(b);
+        setMeans(it.node, done.back());
+        continue;
+      }
+      Cluster c = cl_.get(it.cluster);
+      if (c.left < 0) {
+        LightNode& n = tree_.nodes[it.node];
+        detail::setNodeFromCluster(n, c);
+        tree_.preorder[it.node] = it.pre;
+        NodeMoments& m = tree_.moments[it.node];
+        const Light& l = cl_.lights.lights[n.rep];
+        m.centroid = detail::clusterPoint(l);
+        m.meanAxis = l.direction;
+        m.lights = 1;
+        MomentSums s;
+        s.w = luminance(n.intensity);
+        s.n = 1;
+        s.posU = Vec3d(m.centroid);
+        s.axisU = Vec3d(m.meanAxis);
+        s.pos = s.posU * s.w;
+        s.axis = s.axisU * s.w;
+        done.push_back(s);
+        continue;
+      }
+      uint32_t leftCount = cl_.count(c.left);
+      writeInner(it, c);
+      stack.emplace_back(it, true);
+      stack.emplace_back(LayoutItem{c.right, 2 * it.innerBefore + 2, it.innerBefore + leftCount, it.pre + 2 * leftCount}, false);
+      stack.emplace_back(LayoutItem{c.left, 2 * it.innerBefore + 1, it.innerBefore + 1, it.pre + 1}, false);
+    }
+    return done.back();
+  }
+
+  const ClusterStore& cl_;
+  LightTree& tree_;
+};
 }  // namespace
 
 namespace {
@@ -600,9 +750,8 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   bool withCone = (type == LightType::Oriented || type == LightType::Spot) && coneWeight > 0;
   // Ids: leaves 0..n-1, merges n..2n-2, handed out in fixed blocks.
   ClusterStore clusters{lights, indices, std::vector<Cluster>(n - 1)};
-  auto get = [&](int32_t id) { return clusters.get(id); };
   if (n == 1) {
-    detail::layoutTree(get, 1, 0, tree);
+    TreeWriter(clusters, tree).run(0);
     return tree;
   }
 
@@ -643,7 +792,7 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   AgglomerativeBuilder builder(withCone, coneWeight, seed);
   std::vector<int32_t> root = builder.reduce(clusters, top, 1, nextId, created, true);
   std::copy(created.begin(), created.end(), clusters.merged.begin() + (nextId - int32_t(n)));
-  detail::layoutTree(get, 2 * n - 1, root[0], tree);
+  TreeWriter(clusters, tree).run(root[0]);
   if (progress) progress->add(n <= exactLimit ? double(n) : (1 - kChunkShare) * double(n));
   return tree;
 }

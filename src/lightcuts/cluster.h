@@ -26,6 +26,7 @@ struct Cluster {
   Vec3d intensity;
   uint32_t rep = 0;
   int32_t left = -1, right = -1;
+  uint32_t count = 1;  // lights below (fills what would be padding)
 };
 
 // Position a light occupies in its tree: directional lights cluster by the direction
@@ -70,6 +71,7 @@ inline Cluster mergeClusters(const Cluster& a, const Cluster& b, int32_t ia, int
   c.rep = (c.weight > 0 ? u * c.weight < a.weight : u < 0.5) ? a.rep : b.rep;
   c.left = ia;
   c.right = ib;
+  c.count = a.count + b.count;
   return c;
 }
 

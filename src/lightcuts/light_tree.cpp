@@ -242,10 +242,10 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
         }
       }
       t = buildAgglomerativeTree(lights, idx, k.type, c, seed, std::max<size_t>(options.exactLimit, 2), &progress);
-      computeMoments(lights, t);
+      // The builder fills the moments and the preorder as it lays the tree out.
       if (options.seedData) computeSeedData(lights, t);
     }
-    computePreorder(t);
+    if (t.preorder.size() != t.nodes.size()) computePreorder(t);
     t.type = k.type;
     t.group = k.group;
     forest.trees[i] = std::move(t);

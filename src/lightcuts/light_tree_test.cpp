@@ -144,6 +144,32 @@ TEST(TreeBuild, SkipsLightsWithoutIntensity) {
   EXPECT_EQ(leafCount(f.trees[0], 0), 9u);
 }
 
+// The agglomerative builder lays the tree out, numbers it in preorder and sums its moments
+// in one pass, large subtrees in parallel: the same values, bit for bit, as the separate
+// passes computeMoments and computePreorder (which the seed builder still uses).
+TEST(Agglomerative, FusedLayoutEqualsSeparatePasses) {
+  for (LightType type : {LightType::Omni, LightType::Oriented, LightType::Directional}) {
+    LightSet set = randomLights(50000, type, 33, true);
+    set.lights[7].intensity = Color(0, 0, 0);  // skipped
+    set.lights[8].intensity = Color(1e-30f, 0, 0);  // weight rounds to ~0 in float
+    TreeBuildOptions o{TreeBuilder::Agglomerative, 5};
+    o.exactLimit = 512;  // chunks bottom-up, then the exact top; subtrees over 2^14 lights
+    LightForest f = buildLightForest(set, o);
+    const LightTree& t = f.trees[0];
+    checkTree(set, t);
+    LightTree again = t;
+    computeMoments(set, again);
+    computePreorder(again);
+    ASSERT_EQ(t.moments.size(), again.moments.size());
+    for (size_t i = 0; i < t.nodes.size(); ++i) {
+      ASSERT_EQ(t.moments[i].centroid, again.moments[i].centroid) << i;
+      ASSERT_EQ(t.moments[i].meanAxis, again.moments[i].meanAxis) << i;
+      ASSERT_EQ(t.moments[i].lights, again.moments[i].lights) << i;
+      ASSERT_EQ(t.preorder[i], again.preorder[i]) << i;
+    }
+  }
+}
+
 // Agglomerative clustering must merge the two obvious groups last.
 TEST(Agglomerative, MergesNearbyLightsFirst) {
   LightSet set;
