@@ -596,35 +596,48 @@ class ApproximateClustering {
     return r;
   }
 
+  // A group's surviving cluster ids and, when its greedy merging ran, the metric between
+  // them (dm[i * size + j] = metric(set[i], set[j])): the parent group starts from it and
+  // computes only the pairs across its two halves.
+  struct Reduced {
+    std::vector<int32_t> set;
+    std::vector<float> dm;  // set.size()^2, or empty
+  };
+
   // Clusters the leaves order[b, e) (Morton order); merged clusters take ids from
   // idBase on. Returns the surviving cluster ids.
   std::vector<int32_t> run(const std::vector<int32_t>& order, size_t b, size_t e, int32_t idBase) {
-    size_t n = e - b;
-    std::vector<int32_t> set;
-    if (n <= kGroup) {
-      set.assign(order.begin() + long(b), order.begin() + long(e));
-    } else {
-      size_t h = n / 2;
-      std::vector<int32_t> left, right;
-      int32_t rightBase = idBase + int32_t(h - survivors(h));
-      if (n > 4096) {
-        tbb::task_group g;
-        g.run([&] { left = run(order, b, b + h, idBase); });
-        right = run(order, b + h, e, rightBase);
-        g.wait();
-      } else {
-        left = run(order, b, b + h, idBase);
-        right = run(order, b + h, e, rightBase);
-      }
-      set = std::move(left);
-      set.insert(set.end(), right.begin(), right.end());
-      idBase = rightBase + int32_t((n - h) - survivors(n - h));
-    }
-    combine(set, keep(n), idBase);
-    return set;
+    return reduce(order, b, e, idBase).set;
   }
 
  private:
+  Reduced reduce(const std::vector<int32_t>& order, size_t b, size_t e, int32_t idBase) {
+    size_t n = e - b;
+    Reduced r;
+    if (n <= kGroup) {
+      r.set.assign(order.begin() + long(b), order.begin() + long(e));
+      combine(r.set, keep(n), idBase, nullptr, nullptr, r.dm);
+      return r;
+    }
+    size_t h = n / 2;
+    Reduced left, right;
+    int32_t rightBase = idBase + int32_t(h - survivors(h));
+    if (n > 4096) {
+      tbb::task_group g;
+      g.run([&] { left = reduce(order, b, b + h, idBase); });
+      right = reduce(order, b + h, e, rightBase);
+      g.wait();
+    } else {
+      left = reduce(order, b, b + h, idBase);
+      right = reduce(order, b + h, e, rightBase);
+    }
+    r.set = left.set;
+    r.set.insert(r.set.end(), right.set.begin(), right.set.end());
+    idBase = rightBase + int32_t((n - h) - survivors(n - h));
+    combine(r.set, keep(n), idBase, &left, &right, r.dm);
+    return r;
+  }
+
   float metric(const Cluster& a, const Cluster& x) const {
     Vec3 e = vmax(a.hi, x.hi) - vmin(a.lo, x.lo);
     float m = dot(e, e);
@@ -655,7 +668,9 @@ class ApproximateClustering {
   // the metric between the set's slots (dm[i * stride + j] = metric(set[i], set[j]), both
   // orders, as the metric's rounding is not symmetric): a merge computes the new cluster's
   // row and column once, and a cluster whose neighbour was merged rescans its row.
-  void combine(std::vector<int32_t>& set, size_t target, int32_t idBase) {
+  // The halves' matrices, when given, fill their blocks; `out` receives the final matrix.
+  void combine(std::vector<int32_t>& set, size_t target, int32_t idBase, const Reduced* left,
+               const Reduced* right, std::vector<float>& out) {
     size_t m = set.size();
     if (m <= target) return;
     const size_t stride = m;
@@ -666,8 +681,19 @@ class ApproximateClustering {
     cs.resize(m);
     for (size_t i = 0; i < m; ++i) cs[i] = all_.get(set[i]);
     auto D = [&](size_t i, size_t j) -> float& { return dm[i * stride + j]; };
+    const size_t mL = left ? left->set.size() : 0;
+    const bool haveL = left && !left->dm.empty(), haveR = right && !right->dm.empty();
+    if (haveL)
+      for (size_t i = 0; i < mL; ++i) std::copy_n(&left->dm[i * mL], mL, &D(i, 0));
+    if (haveR) {
+      const size_t mR = m - mL;
+      for (size_t i = 0; i < mR; ++i) std::copy_n(&right->dm[i * mR], mR, &D(mL + i, mL));
+    }
     for (size_t i = 0; i < m; ++i)
-      for (size_t j = i + 1; j < m; ++j) metricPair(cs[i], cs[j], D(i, j), D(j, i));
+      for (size_t j = i + 1; j < m; ++j) {
+        bool known = j < mL ? haveL : (i >= mL && haveR);
+        if (!known) metricPair(cs[i], cs[j], D(i, j), D(j, i));
+      }
     std::vector<float> nnD(m, kInf);
     std::vector<int32_t> nn(m, -1);
     auto refresh = [&](size_t i) {
@@ -728,6 +754,8 @@ class ApproximateClustering {
         }
       }
     }
+    out.resize(m * m);
+    for (size_t i = 0; i < m; ++i) std::copy_n(&dm[i * stride], m, &out[i * m]);
   }
 
   ClusterStore& all_;
