@@ -399,27 +399,11 @@ class AgglomerativeBuilder {
 };
 
 
-// The layout of detail::layoutTree, the moments of computeMoments and the preorder of
-// computePreorder in one pass over the clusters, the subtrees below the top levels in
-// parallel. Node numbers and preorder positions follow from the clusters' light counts:
-// the node taken at preorder position p that has k inner nodes before it in preorder puts
-// its children at 1 + 2k; a left child follows its parent in preorder, a right one follows
-// the left subtree's 2 count - 1 nodes. Moments are summed as computeMoments does (each
-// node's sums = left's + right's, in double), so every value is the same bit for bit.
-struct MomentSums {
-  double w = 0, n = 0;
-  Vec3d pos, axis;    // sum of w x, sum of w n
-  Vec3d posU, axisU;  // unweighted sums
-  void add(const MomentSums& b) {
-    w += b.w;
-    n += b.n;
-    pos += b.pos;
-    axis += b.axis;
-    posU += b.posU;
-    axisU += b.axisU;
-  }
-};
-
+// The layout of detail::layoutTree and the preorder of computePreorder in one pass over the
+// clusters, the subtrees below the top levels in parallel. Node numbers and preorder
+// positions follow from the clusters' light counts: the node taken at preorder position p
+// with k inner nodes before it in preorder puts its children at 1 + 2k; a left child
+// follows its parent in preorder, a right one the left subtree's 2 count - 1 nodes.
 struct LayoutItem {
   int32_t cluster;
   uint32_t node, innerBefore, pre;
@@ -432,121 +416,48 @@ class TreeWriter {
   void run(int32_t root) {
     size_t total = 2 * cl_.leaves() - 1;
     tree_.nodes.resize(total);
-    tree_.moments.resize(total);
     tree_.preorder.resize(total);
     // Top levels serially, down to subtrees of at most kTask lights; those in parallel.
     constexpr uint32_t kTask = 1u << 14;
     std::vector<LayoutItem> tasks;
-    std::unordered_map<uint32_t, uint32_t> taskOf;  // node -> task
     std::vector<LayoutItem> stack{{root, 0, 0, 0}};
     while (!stack.empty()) {
       LayoutItem it = stack.back();
       stack.pop_back();
-      Cluster c = cl_.get(it.cluster);
-      if (c.left < 0 || c.count <= kTask) {
-        taskOf.emplace(it.node, uint32_t(tasks.size()));
+      if (cl_.count(it.cluster) <= kTask) {
         tasks.push_back(it);
         continue;
       }
-      uint32_t leftCount = cl_.count(c.left);
-      writeInner(it, c);
-      stack.push_back(LayoutItem{c.right, 2 * it.innerBefore + 2, it.innerBefore + leftCount,
-                                 it.pre + 2 * leftCount});
-      stack.push_back(LayoutItem{c.left, 2 * it.innerBefore + 1, it.innerBefore + 1, it.pre + 1});
+      write(it, stack);
     }
-    std::vector<MomentSums> taskSums(tasks.size());
-    tbb::parallel_for(size_t(0), tasks.size(), [&](size_t k) { taskSums[k] = subtree(tasks[k]); });
-    // The top levels' moments: computeMoments' walk, a task's root standing for its subtree.
-    std::vector<std::pair<uint32_t, bool>> walk{{0u, false}};
-    std::vector<MomentSums> done;
-    while (!walk.empty()) {
-      auto [i, expanded] = walk.back();
-      walk.pop_back();
-      auto t = taskOf.find(i);
-      if (t != taskOf.end()) {
-        done.push_back(taskSums[t->second]);
-        continue;
+    tbb::parallel_for(size_t(0), tasks.size(), [&](size_t k) {
+      std::vector<LayoutItem> st{tasks[k]};
+      while (!st.empty()) {
+        LayoutItem it = st.back();
+        st.pop_back();
+        write(it, st);
       }
-      const LightNode& n = tree_.nodes[i];
-      if (!expanded) {
-        walk.emplace_back(i, true);
-        walk.emplace_back(n.left + 1, false);
-        walk.emplace_back(n.left, false);
-        continue;
-      }
-      MomentSums b = done.back();
-      done.pop_back();
-      done.back().add(b);
-      setMeans(i, done.back());
-    }
+    });
   }
 
  private:
-  void writeInner(const LayoutItem& it, const Cluster& c) {
+  // Writes one node; pushes its children (left on top).
+  void write(const LayoutItem& it, std::vector<LayoutItem>& stack) {
+    Cluster c = cl_.get(it.cluster);
     LightNode& n = tree_.nodes[it.node];
     detail::setNodeFromCluster(n, c);
-    n.left = 2 * it.innerBefore + 1;
     tree_.preorder[it.node] = it.pre;
-    tree_.moments[it.node].lights = c.count;
-  }
-
-  void setMeans(uint32_t i, const MomentSums& s) {
-    NodeMoments& m = tree_.moments[i];
-    if (s.w > 0) {
-      m.centroid = (s.pos / s.w).toFloat();
-      m.meanAxis = (s.axis / s.w).toFloat();
-    } else {
-      m.centroid = (s.posU / s.n).toFloat();
-      m.meanAxis = (s.axisU / s.n).toFloat();
-    }
-  }
-
-  // One subtree, depth first with explicit stacks (chains of merges can be deep).
-  MomentSums subtree(const LayoutItem& top) {
-    std::vector<std::pair<LayoutItem, bool>> stack{{top, false}};
-    std::vector<MomentSums> done;
-    while (!stack.empty()) {
-      auto [it, expanded] = stack.back();
-      stack.pop_back();
-      if (expanded) {
-        MomentSums b = done.back();
-        done.pop_back();
-        done.back().add(b);
-        setMeans(it.node, done.back());
-        continue;
-      }
-      Cluster c = cl_.get(it.cluster);
-      if (c.left < 0) {
-        LightNode& n = tree_.nodes[it.node];
-        detail::setNodeFromCluster(n, c);
-        tree_.preorder[it.node] = it.pre;
-        NodeMoments& m = tree_.moments[it.node];
-        const Light& l = cl_.lights.lights[n.rep];
-        m.centroid = detail::clusterPoint(l);
-        m.meanAxis = l.direction;
-        m.lights = 1;
-        MomentSums s;
-        s.w = luminance(n.intensity);
-        s.n = 1;
-        s.posU = Vec3d(m.centroid);
-        s.axisU = Vec3d(m.meanAxis);
-        s.pos = s.posU * s.w;
-        s.axis = s.axisU * s.w;
-        done.push_back(s);
-        continue;
-      }
-      uint32_t leftCount = cl_.count(c.left);
-      writeInner(it, c);
-      stack.emplace_back(it, true);
-      stack.emplace_back(LayoutItem{c.right, 2 * it.innerBefore + 2, it.innerBefore + leftCount, it.pre + 2 * leftCount}, false);
-      stack.emplace_back(LayoutItem{c.left, 2 * it.innerBefore + 1, it.innerBefore + 1, it.pre + 1}, false);
-    }
-    return done.back();
+    if (c.left < 0) return;
+    n.left = 2 * it.innerBefore + 1;
+    uint32_t leftCount = cl_.count(c.left);
+    stack.push_back(LayoutItem{c.right, n.left + 1, it.innerBefore + leftCount, it.pre + 2 * leftCount});
+    stack.push_back(LayoutItem{c.left, n.left, it.innerBefore + 1, it.pre + 1});
   }
 
   const ClusterStore& cl_;
   LightTree& tree_;
 };
+
 }  // namespace
 
 namespace {
@@ -780,6 +691,7 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   ClusterStore clusters{lights, indices, std::vector<Cluster>(n - 1)};
   if (n == 1) {
     TreeWriter(clusters, tree).run(0);
+    computeMoments(lights, tree);
     return tree;
   }
 
@@ -821,6 +733,10 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   std::vector<int32_t> root = builder.reduce(clusters, top, 1, nextId, created, true);
   std::copy(created.begin(), created.end(), clusters.merged.begin() + (nextId - int32_t(n)));
   TreeWriter(clusters, tree).run(root[0]);
+  // The clusters go before the moments come: the build's peak is nodes and merges, or
+  // nodes and moments, never all three.
+  std::vector<Cluster>().swap(clusters.merged);
+  computeMoments(lights, tree);
   if (progress) progress->add(n <= exactLimit ? double(n) : (1 - kChunkShare) * double(n));
   return tree;
 }

@@ -144,10 +144,60 @@ TEST(TreeBuild, SkipsLightsWithoutIntensity) {
   EXPECT_EQ(leafCount(f.trees[0], 0), 9u);
 }
 
-// The agglomerative builder lays the tree out, numbers it in preorder and sums its moments
-// in one pass, large subtrees in parallel: the same values, bit for bit, as the separate
-// passes computeMoments and computePreorder (which the seed builder still uses).
-TEST(Agglomerative, FusedLayoutEqualsSeparatePasses) {
+// computeMoments as it was, serial: the reference for the parallel one.
+std::vector<NodeMoments> serialMoments(const LightSet& lights, const LightTree& tree) {
+  struct Sums {
+    double w = 0, n = 0;
+    Vec3d pos, axis, posU, axisU;
+  };
+  std::vector<NodeMoments> m(tree.nodes.size());
+  std::vector<std::pair<uint32_t, bool>> stack{{0u, false}};
+  std::vector<Sums> done;
+  while (!stack.empty()) {
+    auto [i, expanded] = stack.back();
+    stack.pop_back();
+    const LightNode& n = tree.nodes[i];
+    if (n.isLeaf()) {
+      const Light& l = lights.lights[n.rep];
+      m[i].centroid = l.type == LightType::Directional ? -l.direction : l.position;
+      m[i].meanAxis = l.direction;
+      Sums s;
+      s.w = luminance(n.intensity);
+      s.n = 1;
+      s.posU = Vec3d(m[i].centroid);
+      s.axisU = Vec3d(m[i].meanAxis);
+      s.pos = s.posU * s.w;
+      s.axis = s.axisU * s.w;
+      done.push_back(s);
+      continue;
+    }
+    if (!expanded) {
+      stack.emplace_back(i, true);
+      stack.emplace_back(n.left + 1, false);
+      stack.emplace_back(n.left, false);
+      continue;
+    }
+    Sums b = done.back();
+    done.pop_back();
+    Sums& s = done.back();
+    s.w += b.w;
+    s.n += b.n;
+    s.pos += b.pos;
+    s.axis += b.axis;
+    s.posU += b.posU;
+    s.axisU += b.axisU;
+    Vec3d c = s.w > 0 ? s.pos / s.w : s.posU / s.n, a = s.w > 0 ? s.axis / s.w : s.axisU / s.n;
+    m[i].centroid = c.toFloat();
+    m[i].meanAxis = a.toFloat();
+    m[i].lights = m[n.left].lights + m[n.left + 1].lights;
+  }
+  return m;
+}
+
+// The agglomerative builder lays the tree out and numbers it in preorder in one pass, and
+// sums the moments in parallel, large subtrees side by side: the same values, bit for bit,
+// as the serial passes (computePreorder; computeMoments as it was).
+TEST(Agglomerative, ParallelLayoutAndMomentsEqualSerialPasses) {
   for (LightType type : {LightType::Omni, LightType::Oriented, LightType::Directional}) {
     LightSet set = randomLights(50000, type, 33, true);
     set.lights[7].intensity = Color(0, 0, 0);  // skipped
@@ -158,13 +208,13 @@ TEST(Agglomerative, FusedLayoutEqualsSeparatePasses) {
     const LightTree& t = f.trees[0];
     checkTree(set, t);
     LightTree again = t;
-    computeMoments(set, again);
     computePreorder(again);
-    ASSERT_EQ(t.moments.size(), again.moments.size());
+    std::vector<NodeMoments> ref = serialMoments(set, t);
+    ASSERT_EQ(t.moments.size(), ref.size());
     for (size_t i = 0; i < t.nodes.size(); ++i) {
-      ASSERT_EQ(t.moments[i].centroid, again.moments[i].centroid) << i;
-      ASSERT_EQ(t.moments[i].meanAxis, again.moments[i].meanAxis) << i;
-      ASSERT_EQ(t.moments[i].lights, again.moments[i].lights) << i;
+      ASSERT_EQ(t.moments[i].centroid, ref[i].centroid) << i;
+      ASSERT_EQ(t.moments[i].meanAxis, ref[i].meanAxis) << i;
+      ASSERT_EQ(t.moments[i].lights, ref[i].lights) << i;
       ASSERT_EQ(t.preorder[i], again.preorder[i]) << i;
     }
   }
