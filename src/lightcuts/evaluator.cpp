@@ -284,7 +284,7 @@ class Lightcuts final : public LightEvaluator {
       const LightNode& root = tree.nodes[0];
       ShadowResult shadow;
       Color unit = shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats, shadow,
-                                probes && tree.moments[0].lights >= kProbeMinLights);
+                                probes && tree.lightCount(0) >= kProbeMinLights);
       addNode(t, 0, unit, shadow);
     }
     const float eps = opt_.errorRatio;
@@ -305,7 +305,7 @@ class Lightcuts final : public LightEvaluator {
       sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
       const LightTree& tree = forest_.trees[cn.tree];
       const LightGroup& g = lights_.groups[tree.group];
-      if (probes && cn.shadow.blocker >= 0 && tree.moments[cn.node].lights >= kProbeMinLights &&
+      if (probes && cn.shadow.blocker >= 0 && tree.lightCount(cn.node) >= kProbeMinLights &&
           hiddenCluster(tree.nodes[cn.node], tree.type, sp, cn.shadow, vis, stats)) {
         // Its representative is hidden, and so is the whole cluster: it stays in the cut,
         // exactly 0, instead of being refined down to its lights.
@@ -325,7 +325,7 @@ class Lightcuts final : public LightEvaluator {
         shadows[k] = cn.shadow;
         units[k] = rep == n.rep ? cn.unit
                                 : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, shadows[k],
-                                               probes && tree.moments[c].lights >= kProbeMinLights);
+                                               probes && tree.lightCount(c) >= kProbeMinLights);
       }
       // A shadow boundary: one child's representative is hidden, the other's not.
       bool boundary = false;
@@ -345,7 +345,7 @@ class Lightcuts final : public LightEvaluator {
       if (cn.firstOrder) {
         const LightTree& tree = forest_.trees[cn.tree];
         const LightNode& n = tree.nodes[cn.node];
-        Color fo = vmax(firstOrderUnit(lights_.lights[n.rep], lights_.groups[tree.group], sp, tree.moments[cn.node],
+        Color fo = vmax(firstOrderUnit(lights_.lights[n.rep], lights_.groups[tree.group], sp, tree.momentsOf(lights_, cn.node),
                                        cn.unit) * n.intensity, Color(0));
         float raw = luminance(cn.estimate), lf = luminance(fo);
         if (raw > 0 && lf > 0) {
@@ -431,7 +431,7 @@ class SeedCuts final : public LightEvaluator {
       if (tree.seed.size() == tree.nodes.size()) {
         seed_[t] = tree.seed.data();
       } else {
-        owned_.push_back(seedNodeData(tree));
+        owned_.push_back(seedNodeData(lights, tree));
         seed_[t] = owned_.back().data();
       }
     }

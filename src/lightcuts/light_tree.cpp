@@ -134,15 +134,12 @@ MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, uint32_t top,
       continue;
     }
     if (n.isLeaf()) {
-      const Light& l = lights.lights[n.rep];
-      m[i].centroid = l.type == LightType::Directional ? -l.direction : l.position;
-      m[i].meanAxis = l.direction;
-      m[i].lights = 1;
+      const NodeMoments leaf = tree.momentsOf(lights, i);
       MomentSums s;
       s.w = luminance(n.intensity);
       s.n = 1;
-      s.posU = Vec3d(m[i].centroid);
-      s.axisU = Vec3d(m[i].meanAxis);
+      s.posU = Vec3d(leaf.centroid);
+      s.axisU = Vec3d(leaf.meanAxis);
       s.pos = s.posU * s.w;
       s.axis = s.axisU * s.w;
       done.push_back(s);
@@ -157,8 +154,9 @@ MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, uint32_t top,
     MomentSums b = done.back();
     done.pop_back();
     done.back().add(b);  // the left child's sums become this node's
-    setMeans(m[i], done.back());
-    m[i].lights = m[n.left].lights + m[n.left + 1].lights;
+    NodeMoments& mi = m[(n.left - 1) / 2];
+    setMeans(mi, done.back());
+    mi.lights = tree.lightCount(n.left) + tree.lightCount(n.left + 1);
   }
   return done.back();
 }
@@ -173,7 +171,7 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
   // node's sums are its left child's plus its right child's, so the subtrees below the
   // top levels are summed in parallel to the same values. Memory: the tree's depth.
   std::vector<NodeMoments>& m = tree.moments;
-  m.assign(tree.nodes.size(), NodeMoments{});
+  m.assign(tree.nodes.size() / 2, NodeMoments{});  // one per inner node
   if (tree.nodes.empty()) return;
   if (tree.preorder.size() != tree.nodes.size()) computePreorder(tree);
   // Top levels: split down to subtrees of at most kTask lights. A node's light count from
@@ -191,7 +189,7 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
       tasks.push_back(i);
       continue;
     }
-    m[i].lights = count;
+    m[(n.left - 1) / 2].lights = count;
     uint32_t leftCount = (tree.preorder[n.left + 1] - tree.preorder[n.left] + 1) / 2;
     stack.emplace_back(n.left + 1, count - leftCount);
     stack.emplace_back(n.left, leftCount);
@@ -209,11 +207,11 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
 }
 
 void computeSeedData(const LightSet& lights, LightTree& tree) {
-  if (tree.moments.size() != tree.nodes.size()) computeMoments(lights, tree);
-  tree.seed = seedNodeData(tree);
+  if (tree.moments.size() != tree.nodes.size() / 2) computeMoments(lights, tree);
+  tree.seed = seedNodeData(lights, tree);
 }
 
-std::vector<SeedNodeData> seedNodeData(const LightTree& tree) {
+std::vector<SeedNodeData> seedNodeData(const LightSet& lights, const LightTree& tree) {
   // Bottom-up, from the moments. The mean distance to the centroid is exact for leaves and
   // bounded above through the triangle inequality for inner nodes; the seed builder
   // overwrites it with exact values.
@@ -226,7 +224,7 @@ std::vector<SeedNodeData> seedNodeData(const LightTree& tree) {
   for (size_t i = tree.nodes.size(); i-- > 0;) {
     const LightNode& n = tree.nodes[i];
     SeedNodeData& d = sd[i];
-    const NodeMoments& mo = tree.moments[i];
+    const NodeMoments mo = tree.momentsOf(lights, i);
     d.position = mo.centroid;
     if (n.isLeaf()) {
       d.direction = mo.meanAxis;

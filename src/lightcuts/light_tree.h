@@ -60,11 +60,27 @@ struct LightTree {
   // Parallel to nodes when filled: the seed builder fills it; agglomerative trees leave it
   // empty (unless TreeBuildOptions::seedData) and makeSeedCuts computes it on demand.
   std::vector<SeedNodeData> seed;
-  std::vector<NodeMoments> moments;  // parallel to nodes
+  // Per inner node, at (left - 1) / 2: sibling pairs sit at nodes 1-2, 3-4, ..., so that is
+  // each inner node's own slot (n - 1 of them). A leaf's moments are its light's
+  // (momentsOf); storing them would repeat the light (28 bytes per light).
+  std::vector<NodeMoments> moments;
   // Parallel to nodes: each node's position in a depth-first walk that visits the left
   // child (n.left) before the right one, so a subtree is a contiguous range. Reconstruction
   // cuts (reconstruction.h) compare cuts of different points by it.
   std::vector<uint32_t> preorder;
+
+  // Node i's moments: stored for inner nodes, made from the light for a leaf.
+  NodeMoments momentsOf(const LightSet& lights, uint32_t i) const {
+    const LightNode& n = nodes[i];
+    if (!n.isLeaf()) return moments[(n.left - 1) / 2];
+    const Light& l = lights.lights[n.rep];
+    return NodeMoments{l.type == LightType::Directional ? -l.direction : l.position, l.direction, 1};
+  }
+  // How many lights node i holds.
+  uint32_t lightCount(uint32_t i) const {
+    const LightNode& n = nodes[i];
+    return n.isLeaf() ? 1u : moments[(n.left - 1) / 2].lights;
+  }
 };
 
 enum class TreeBuilder { Agglomerative, Seed };
@@ -127,6 +143,6 @@ void computeMoments(const LightSet& lights, LightTree& tree);
 // directions, errors).
 void computeSeedData(const LightSet& lights, LightTree& tree);
 // The same data, for a tree that has its moments, without touching the tree.
-std::vector<SeedNodeData> seedNodeData(const LightTree& tree);
+std::vector<SeedNodeData> seedNodeData(const LightSet& lights, const LightTree& tree);
 
 }  // namespace lc::lightcuts

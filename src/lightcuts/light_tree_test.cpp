@@ -74,7 +74,7 @@ TEST_P(TreeBuild, IsAValidClusterHierarchy) {
     LightForest f = buildLightForest(set, TreeBuildOptions{builder, 5});
     ASSERT_EQ(f.trees.size(), 1u);
     checkTree(set, f.trees[0]);
-    ASSERT_EQ(f.trees[0].moments.size(), f.trees[0].nodes.size());
+    ASSERT_EQ(f.trees[0].moments.size(), f.trees[0].nodes.size() / 2);  // inner nodes only
     // Only the seed builder stores the seed's traversal data; others leave it to makeSeedCuts.
     ASSERT_EQ(f.trees[0].seed.size(), builder == TreeBuilder::Seed ? f.trees[0].nodes.size() : 0u);
   }
@@ -92,7 +92,7 @@ TEST(TreeBuild, SeedDataOnDemandEqualsEager) {
     ASSERT_EQ(a.trees[0].seed.size(), a.trees[0].nodes.size());
     ASSERT_TRUE(b.trees[0].seed.empty());
     EXPECT_LT(b.memoryBytes(), a.memoryBytes());
-    std::vector<SeedNodeData> lazy = seedNodeData(b.trees[0]);
+    std::vector<SeedNodeData> lazy = seedNodeData(set, b.trees[0]);
     ASSERT_EQ(lazy.size(), a.trees[0].seed.size());
     for (size_t i = 0; i < lazy.size(); ++i) {
       ASSERT_EQ(lazy[i].position, a.trees[0].seed[i].position) << i;
@@ -210,11 +210,13 @@ TEST(Agglomerative, ParallelLayoutAndMomentsEqualSerialPasses) {
     LightTree again = t;
     computePreorder(again);
     std::vector<NodeMoments> ref = serialMoments(set, t);
-    ASSERT_EQ(t.moments.size(), ref.size());
-    for (size_t i = 0; i < t.nodes.size(); ++i) {
-      ASSERT_EQ(t.moments[i].centroid, ref[i].centroid) << i;
-      ASSERT_EQ(t.moments[i].meanAxis, ref[i].meanAxis) << i;
-      ASSERT_EQ(t.moments[i].lights, ref[i].lights) << i;
+    ASSERT_EQ(t.nodes.size(), ref.size());
+    for (uint32_t i = 0; i < t.nodes.size(); ++i) {
+      const NodeMoments got = t.momentsOf(set, i);
+      ASSERT_EQ(got.centroid, ref[i].centroid) << i;
+      ASSERT_EQ(got.meanAxis, ref[i].meanAxis) << i;
+      ASSERT_EQ(got.lights, ref[i].lights) << i;
+      ASSERT_EQ(t.lightCount(i), ref[i].lights) << i;
       ASSERT_EQ(t.preorder[i], again.preorder[i]) << i;
     }
   }
@@ -390,7 +392,7 @@ TEST(Precision, MomentsOfAMillionLevelChainAreExact) {
   }
   computeMoments(s, t);
   for (uint32_t j : {0u, 1u, 1000u, kN / 2, kN - 10}) {
-    const NodeMoments& m = t.moments[2 * j];
+    const NodeMoments m = t.momentsOf(s, 2 * j);
     const double want = (double(j) + double(kN - 1)) / (2.0 * kN);
     EXPECT_NEAR(m.centroid.x, want, 1e-6 * want) << "node of the suffix from light " << j;
     EXPECT_EQ(m.lights, kN - j);
