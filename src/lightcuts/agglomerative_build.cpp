@@ -51,6 +51,14 @@ struct ClusterStore {
   }
   Cluster& mergedAt(int32_t id) { return merged[size_t(id) - leaves()]; }
   uint32_t count(int32_t id) const { return size_t(id) < leaves() ? 1u : merged[size_t(id) - leaves()].count; }
+  // Leaves are read in Morton order, their lights scattered in memory: prefetching a batch's
+  // indices, then their lights, overlaps the cache misses.
+  void prefetch(const int32_t* ids, size_t count) const {
+    for (size_t k = 0; k < count; ++k)
+      if (size_t(ids[k]) < leaves()) __builtin_prefetch(&indices[size_t(ids[k])]);
+    for (size_t k = 0; k < count; ++k)
+      if (size_t(ids[k]) < leaves()) __builtin_prefetch(&lights.lights[indices[size_t(ids[k])]]);
+  }
 };
 
 constexpr int kLeafSize = 4;
@@ -431,12 +439,27 @@ class TreeWriter {
       write(it, stack);
     }
     tbb::parallel_for(size_t(0), tasks.size(), [&](size_t k) {
-      std::vector<LayoutItem> st{tasks[k]};
+      // Leaves are written in batches, their lights prefetched first (see prefetch()).
+      std::vector<LayoutItem> st{tasks[k]}, leaves;
+      std::vector<int32_t> ids;
+      auto flush = [&] {
+        cl_.prefetch(ids.data(), ids.size());
+        for (const LayoutItem& it : leaves) write(it, st);
+        leaves.clear();
+        ids.clear();
+      };
       while (!st.empty()) {
         LayoutItem it = st.back();
         st.pop_back();
+        if (size_t(it.cluster) < cl_.leaves()) {
+          leaves.push_back(it);
+          ids.push_back(it.cluster);
+          if (leaves.size() == 64) flush();
+          continue;
+        }
         write(it, st);
       }
+      flush();
     });
   }
 
@@ -526,6 +549,13 @@ class ApproximateClustering {
     size_t n = e - b;
     Reduced r;
     if (n <= kGroup) {
+      // Look ahead along the Morton order: the indices of the leaves two groups on, the
+      // lights of the next group's (whose indices the previous group fetched).
+      const size_t end = order.size();
+      for (size_t k = std::min(end, e + kGroup); k < std::min(end, e + 2 * kGroup); ++k)
+        __builtin_prefetch(&all_.indices[size_t(order[k])]);
+      for (size_t k = e; k < std::min(end, e + kGroup); ++k)
+        __builtin_prefetch(&all_.lights.lights[all_.indices[size_t(order[k])]]);
       r.set.assign(order.begin() + long(b), order.begin() + long(e));
       combine(r.set, keep(n), idBase, nullptr, nullptr, r.dm);
       return r;
@@ -590,6 +620,7 @@ class ApproximateClustering {
     // The set's clusters, copied: leaves are made from their lights once, not per pair.
     static thread_local std::vector<Cluster> cs;
     cs.resize(m);
+    all_.prefetch(set.data(), m);
     for (size_t i = 0; i < m; ++i) cs[i] = all_.get(set[i]);
     auto D = [&](size_t i, size_t j) -> float& { return dm[i * stride + j]; };
     const size_t mL = left ? left->set.size() : 0;
