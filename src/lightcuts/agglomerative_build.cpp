@@ -37,6 +37,39 @@ namespace {
 
 using detail::Cluster;
 
+// The clusters of one build by id: leaves (0..n-1) made from their lights when asked, so
+// that only the n - 1 merges (n..2n-2) take memory (88 bytes each).
+inline double lightLuminance(const Color& c) {
+  return 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z);
+}
+
+struct ClusterStore {
+  const LightSet& lights;
+  const std::vector<uint32_t>& indices;
+  std::vector<Cluster> merged;  // id n + k at k
+  double weightScale = 1;       // leaf weights: luminance over the brightest light's
+
+  size_t leaves() const { return indices.size(); }
+  Cluster get(int32_t id) const {
+    size_t i = size_t(id);
+    if (i >= leaves()) return merged[i - leaves()];
+    const Light& l = lights.lights[indices[i]];
+    Cluster c = detail::leafCluster(l, indices[i]);
+    c.weight = float(lightLuminance(l.intensity) * weightScale);
+    return c;
+  }
+  Cluster& mergedAt(int32_t id) { return merged[size_t(id) - leaves()]; }
+  uint32_t count(int32_t id) const { return size_t(id) < leaves() ? 1u : merged[size_t(id) - leaves()].count; }
+  // Leaves are read in Morton order, their lights scattered in memory: prefetching a batch's
+  // indices, then their lights, overlaps the cache misses.
+  void prefetch(const int32_t* ids, size_t count) const {
+    for (size_t k = 0; k < count; ++k)
+      if (size_t(ids[k]) < leaves()) __builtin_prefetch(&indices[size_t(ids[k])]);
+    for (size_t k = 0; k < count; ++k)
+      if (size_t(ids[k]) < leaves()) __builtin_prefetch(&lights.lights[indices[size_t(ids[k])]]);
+  }
+};
+
 constexpr int kLeafSize = 4;
 
 // A cluster as the k-d leaves hold it: compact and contiguous, so a leaf scan touches one
@@ -102,7 +135,7 @@ class AgglomerativeBuilder {
 
   // Clusters `ids` (indices into `all`) until `target` remain. Appends the merged clusters,
   // with children as global ids, to `created` and returns the global ids of the survivors.
-  std::vector<int32_t> reduce(const std::vector<Cluster>& all, const std::vector<int32_t>& ids,
+  std::vector<int32_t> reduce(const ClusterStore& all, const std::vector<int32_t>& ids,
                               size_t target, int32_t idBase, std::vector<Cluster>& created,
                               bool parallelQueries) {
     size_t n = ids.size();
@@ -112,7 +145,7 @@ class AgglomerativeBuilder {
     global_.clear();
     global_.reserve(2 * n);
     for (int32_t g : ids) {
-      cl_.push_back(all[size_t(g)]);
+      cl_.push_back(all.get(g));
       global_.push_back(g);
     }
     slotOf_.assign(2 * n, -1);
@@ -382,6 +415,81 @@ class AgglomerativeBuilder {
   size_t aliveAtBuild_ = 0;
 };
 
+
+// The layout of detail::layoutTree and the preorder of computePreorder in one pass over the
+// clusters, the subtrees below the top levels in parallel. Node numbers and preorder
+// positions follow from the clusters' light counts: the node taken at preorder position p
+// with k inner nodes before it in preorder puts its children at 1 + 2k; a left child
+// follows its parent in preorder, a right one the left subtree's 2 count - 1 nodes.
+struct LayoutItem {
+  int32_t cluster;
+  uint32_t node, innerBefore, pre;
+};
+
+class TreeWriter {
+ public:
+  TreeWriter(const ClusterStore& clusters, LightTree& tree) : cl_(clusters), tree_(tree) {}
+
+  void run(int32_t root) {
+    size_t total = 2 * cl_.leaves() - 1;
+    tree_.nodes.resize(total);
+    tree_.preorder.resize(total);
+    // Top levels serially, down to subtrees of at most kTask lights; those in parallel.
+    constexpr uint32_t kTask = 1u << 14;
+    std::vector<LayoutItem> tasks;
+    std::vector<LayoutItem> stack{{root, 0, 0, 0}};
+    while (!stack.empty()) {
+      LayoutItem it = stack.back();
+      stack.pop_back();
+      if (cl_.count(it.cluster) <= kTask) {
+        tasks.push_back(it);
+        continue;
+      }
+      write(it, stack);
+    }
+    tbb::parallel_for(size_t(0), tasks.size(), [&](size_t k) {
+      // Leaves are written in batches, their lights prefetched first (see prefetch()).
+      std::vector<LayoutItem> st{tasks[k]}, leaves;
+      std::vector<int32_t> ids;
+      auto flush = [&] {
+        cl_.prefetch(ids.data(), ids.size());
+        for (const LayoutItem& it : leaves) write(it, st);
+        leaves.clear();
+        ids.clear();
+      };
+      while (!st.empty()) {
+        LayoutItem it = st.back();
+        st.pop_back();
+        if (size_t(it.cluster) < cl_.leaves()) {
+          leaves.push_back(it);
+          ids.push_back(it.cluster);
+          if (leaves.size() == 64) flush();
+          continue;
+        }
+        write(it, st);
+      }
+      flush();
+    });
+  }
+
+ private:
+  // Writes one node; pushes its children (left on top).
+  void write(const LayoutItem& it, std::vector<LayoutItem>& stack) {
+    Cluster c = cl_.get(it.cluster);
+    LightNode& n = tree_.nodes[it.node];
+    detail::setNodeFromCluster(n, c);
+    tree_.preorder[it.node] = it.pre;
+    if (c.left < 0) return;
+    n.left = 2 * it.innerBefore + 1;
+    uint32_t leftCount = cl_.count(c.left);
+    stack.push_back(LayoutItem{c.right, n.left + 1, it.innerBefore + leftCount, it.pre + 2 * leftCount});
+    stack.push_back(LayoutItem{c.left, n.left, it.innerBefore + 1, it.pre + 1});
+  }
+
+  const ClusterStore& cl_;
+  LightTree& tree_;
+};
+
 }  // namespace
 
 namespace {
@@ -410,7 +518,7 @@ class ApproximateClustering {
   static constexpr size_t kGroup = 20;  // delta: lights per bottom group
   static constexpr double kAlpha = 0.4;
 
-  ApproximateClustering(std::vector<Cluster>& all, bool withCone, float coneWeight, uint64_t seed)
+  ApproximateClustering(ClusterStore& all, bool withCone, float coneWeight, uint64_t seed)
       : all_(all), withCone_(withCone), c2_(coneWeight * coneWeight), seed_(seed) {}
 
   // Clusters kept by a group of n: f(n) = c n^alpha with f(delta) = delta / 2.
@@ -431,35 +539,55 @@ class ApproximateClustering {
     return r;
   }
 
+  // A group's surviving cluster ids and, when its greedy merging ran, the metric between
+  // them (dm[i * size + j] = metric(set[i], set[j])): the parent group starts from it and
+  // computes only the pairs across its two halves.
+  struct Reduced {
+    std::vector<int32_t> set;
+    std::vector<float> dm;  // set.size()^2, or empty
+  };
+
   // Clusters the leaves order[b, e) (Morton order); merged clusters take ids from
   // idBase on. Returns the surviving cluster ids.
   std::vector<int32_t> run(const std::vector<int32_t>& order, size_t b, size_t e, int32_t idBase) {
-    size_t n = e - b;
-    std::vector<int32_t> set;
-    if (n <= kGroup) {
-      set.assign(order.begin() + long(b), order.begin() + long(e));
-    } else {
-      size_t h = n / 2;
-      std::vector<int32_t> left, right;
-      int32_t rightBase = idBase + int32_t(h - survivors(h));
-      if (n > 4096) {
-        tbb::task_group g;
-        g.run([&] { left = run(order, b, b + h, idBase); });
-        right = run(order, b + h, e, rightBase);
-        g.wait();
-      } else {
-        left = run(order, b, b + h, idBase);
-        right = run(order, b + h, e, rightBase);
-      }
-      set = std::move(left);
-      set.insert(set.end(), right.begin(), right.end());
-      idBase = rightBase + int32_t((n - h) - survivors(n - h));
-    }
-    combine(set, keep(n), idBase);
-    return set;
+    return reduce(order, b, e, idBase).set;
   }
 
  private:
+  Reduced reduce(const std::vector<int32_t>& order, size_t b, size_t e, int32_t idBase) {
+    size_t n = e - b;
+    Reduced r;
+    if (n <= kGroup) {
+      // Look ahead along the Morton order: the indices of the leaves two groups on, the
+      // lights of the next group's (whose indices the previous group fetched).
+      const size_t end = order.size();
+      for (size_t k = std::min(end, e + kGroup); k < std::min(end, e + 2 * kGroup); ++k)
+        __builtin_prefetch(&all_.indices[size_t(order[k])]);
+      for (size_t k = e; k < std::min(end, e + kGroup); ++k)
+        __builtin_prefetch(&all_.lights.lights[all_.indices[size_t(order[k])]]);
+      r.set.assign(order.begin() + long(b), order.begin() + long(e));
+      combine(r.set, keep(n), idBase, nullptr, nullptr, r.dm);
+      return r;
+    }
+    size_t h = n / 2;
+    Reduced left, right;
+    int32_t rightBase = idBase + int32_t(h - survivors(h));
+    if (n > 4096) {
+      tbb::task_group g;
+      g.run([&] { left = reduce(order, b, b + h, idBase); });
+      right = reduce(order, b + h, e, rightBase);
+      g.wait();
+    } else {
+      left = reduce(order, b, b + h, idBase);
+      right = reduce(order, b + h, e, rightBase);
+    }
+    r.set = left.set;
+    r.set.insert(r.set.end(), right.set.begin(), right.set.end());
+    idBase = rightBase + int32_t((n - h) - survivors(n - h));
+    combine(r.set, keep(n), idBase, &left, &right, r.dm);
+    return r;
+  }
+
   float metric(const Cluster& a, const Cluster& x) const {
     Vec3 e = vmax(a.hi, x.hi) - vmin(a.lo, x.lo);
     float m = dot(e, e);
@@ -490,15 +618,33 @@ class ApproximateClustering {
   // the metric between the set's slots (dm[i * stride + j] = metric(set[i], set[j]), both
   // orders, as the metric's rounding is not symmetric): a merge computes the new cluster's
   // row and column once, and a cluster whose neighbour was merged rescans its row.
-  void combine(std::vector<int32_t>& set, size_t target, int32_t idBase) {
+  // The halves' matrices, when given, fill their blocks; `out` receives the final matrix.
+  void combine(std::vector<int32_t>& set, size_t target, int32_t idBase, const Reduced* left,
+               const Reduced* right, std::vector<float>& out) {
     size_t m = set.size();
     if (m <= target) return;
     const size_t stride = m;
     static thread_local std::vector<float> dm;
     dm.resize(m * m);
+    // The set's clusters, copied: leaves are made from their lights once, not per pair.
+    static thread_local std::vector<Cluster> cs;
+    cs.resize(m);
+    all_.prefetch(set.data(), m);
+    for (size_t i = 0; i < m; ++i) cs[i] = all_.get(set[i]);
     auto D = [&](size_t i, size_t j) -> float& { return dm[i * stride + j]; };
+    const size_t mL = left ? left->set.size() : 0;
+    const bool haveL = left && !left->dm.empty(), haveR = right && !right->dm.empty();
+    if (haveL)
+      for (size_t i = 0; i < mL; ++i) std::copy_n(&left->dm[i * mL], mL, &D(i, 0));
+    if (haveR) {
+      const size_t mR = m - mL;
+      for (size_t i = 0; i < mR; ++i) std::copy_n(&right->dm[i * mR], mR, &D(mL + i, mL));
+    }
     for (size_t i = 0; i < m; ++i)
-      for (size_t j = i + 1; j < m; ++j) metricPair(all_[size_t(set[i])], all_[size_t(set[j])], D(i, j), D(j, i));
+      for (size_t j = i + 1; j < m; ++j) {
+        bool known = j < mL ? haveL : (i >= mL && haveR);
+        if (!known) metricPair(cs[i], cs[j], D(i, j), D(j, i));
+      }
     std::vector<float> nnD(m, kInf);
     std::vector<int32_t> nn(m, -1);
     auto refresh = [&](size_t i) {
@@ -521,13 +667,14 @@ class ApproximateClustering {
         if (nnD[k] < nnD[i]) i = k;
       size_t j = size_t(nn[i]);
       int32_t id = next++;
-      all_[size_t(id)] = detail::mergeClusters(all_[size_t(set[i])], all_[size_t(set[j])], set[i], set[j],
-                                               withCone_, seed_);
+      cs[i] = detail::mergeClusters(cs[i], cs[j], set[i], set[j], withCone_, seed_);
+      all_.mergedAt(id) = cs[i];
       // The merged cluster takes i's place; the last one moves into j's (its row and
       // column with it).
       set[i] = id;
       size_t last = m - 1;
       set[j] = set[last];
+      cs[j] = cs[last];
       nnD[j] = nnD[last];
       nn[j] = nn[last];
       if (j != last)
@@ -542,7 +689,7 @@ class ApproximateClustering {
       if (i == last) i = j;
       for (size_t k = 0; k < m; ++k) {
         if (k == i) continue;
-        metricPair(all_[size_t(set[i])], all_[size_t(set[k])], D(i, k), D(k, i));
+        metricPair(cs[i], cs[k], D(i, k), D(k, i));
       }
       refresh(i);
       for (size_t k = 0; k < m; ++k) {
@@ -558,9 +705,11 @@ class ApproximateClustering {
         }
       }
     }
+    out.resize(m * m);
+    for (size_t i = 0; i < m; ++i) std::copy_n(&dm[i * stride], m, &out[i * m]);
   }
 
-  std::vector<Cluster>& all_;
+  ClusterStore& all_;
   bool withCone_;
   float c2_;
   uint64_t seed_;
@@ -579,26 +728,18 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   size_t n = indices.size();
   bool withCone = (type == LightType::Oriented || type == LightType::Spot) && coneWeight > 0;
   // Ids: leaves 0..n-1, merges n..2n-2, handed out in fixed blocks.
-  std::vector<Cluster> clusters(2 * n - 1);
-  for (size_t i = 0; i < n; ++i) clusters[i] = detail::leafCluster(lights.lights[indices[i]], indices[i]);
+  ClusterStore clusters{lights, indices, std::vector<Cluster>(n - 1)};
   // Weights relative to the brightest light (luminance in double): the metric's sums and
   // products stay finite whatever the power. Lights of 1e38 would otherwise give inf (or
   // NaN from inf * 0) metrics, and the nearest-neighbour search never found a partner.
   {
     double maxLum = 0;
-    std::vector<double> lum(n);
-    for (size_t i = 0; i < n; ++i) {
-      const Vec3d& c = clusters[i].intensity;
-      lum[i] = 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z);
-      if (lum[i] > maxLum) maxLum = lum[i];
-    }
-    for (size_t i = 0; i < n; ++i) {
-      double w = maxLum > 0 && std::isfinite(maxLum) ? lum[i] / maxLum : 1.0;
-      clusters[i].weight = std::isfinite(w) && w >= 0 ? float(w) : 1.0f;
-    }
+    for (size_t i = 0; i < n; ++i) maxLum = std::max(maxLum, lightLuminance(lights.lights[indices[i]].intensity));
+    clusters.weightScale = maxLum > 0 && std::isfinite(maxLum) ? 1 / maxLum : 1.0;
   }
   if (n == 1) {
-    detail::layoutTree(clusters, 0, tree);
+    TreeWriter(clusters, tree).run(0);
+    computeMoments(lights, tree);
     return tree;
   }
 
@@ -608,9 +749,10 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
     for (size_t i = 0; i < n; ++i) top.push_back(int32_t(i));
   } else {
     Bounds3 b;
-    for (size_t i = 0; i < n; ++i) b.extend(clusters[i].lo);
+    auto point = [&](size_t i) { return detail::clusterPoint(lights.lights[indices[i]]); };
+    for (size_t i = 0; i < n; ++i) b.extend(point(i));
     std::vector<std::pair<uint32_t, int32_t>> keyed(n);
-    tbb::parallel_for(size_t(0), n, [&](size_t i) { keyed[i] = {mortonCode(clusters[i].lo, b), int32_t(i)}; });
+    tbb::parallel_for(size_t(0), n, [&](size_t i) { keyed[i] = {mortonCode(point(i), b), int32_t(i)}; });
     tbb::parallel_sort(keyed.begin(), keyed.end());
     std::vector<int32_t> order(n);
     for (size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
@@ -637,8 +779,12 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   std::vector<Cluster> created;
   AgglomerativeBuilder builder(withCone, coneWeight, seed);
   std::vector<int32_t> root = builder.reduce(clusters, top, 1, nextId, created, true);
-  std::copy(created.begin(), created.end(), clusters.begin() + nextId);
-  detail::layoutTree(clusters, root[0], tree);
+  std::copy(created.begin(), created.end(), clusters.merged.begin() + (nextId - int32_t(n)));
+  TreeWriter(clusters, tree).run(root[0]);
+  // The clusters go before the moments come: the build's peak is nodes and merges, or
+  // nodes and moments, never all three.
+  std::vector<Cluster>().swap(clusters.merged);
+  computeMoments(lights, tree);
   if (progress) progress->add(n <= exactLimit ? double(n) : (1 - kChunkShare) * double(n));
   return tree;
 }

@@ -28,6 +28,7 @@ struct Cluster {
   Vec3d intensity;
   uint32_t rep = 0;
   int32_t left = -1, right = -1;
+  uint32_t count = 1;  // lights below (fills what would be padding)
 };
 
 // Position a light occupies in its tree: directional lights cluster by the direction
@@ -72,6 +73,7 @@ inline Cluster mergeClusters(const Cluster& a, const Cluster& b, int32_t ia, int
   c.rep = (c.weight > 0 ? u * c.weight < a.weight : u < 0.5) ? a.rep : b.rep;
   c.left = ia;
   c.right = ib;
+  c.count = a.count + b.count;
   return c;
 }
 
@@ -89,15 +91,17 @@ inline void setNodeFromCluster(LightNode& n, const Cluster& c) {
 }
 
 // Lays the cluster tree under `root` out as LightNodes: root first, siblings adjacent.
-inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, LightTree& tree) {
+// `get(id)` returns cluster id (by value or reference); `count` bounds the node count.
+template <class Get>
+void layoutTree(const Get& get, size_t count, int32_t root, LightTree& tree) {
   tree.nodes.clear();
-  tree.nodes.reserve(clusters.size());
+  tree.nodes.reserve(count);
   tree.nodes.push_back(LightNode{});
   std::vector<std::pair<int32_t, uint32_t>> stack{{root, 0u}};
   while (!stack.empty()) {
     auto [ci, ni] = stack.back();
     stack.pop_back();
-    const Cluster& c = clusters[size_t(ci)];
+    const Cluster& c = get(ci);
     setNodeFromCluster(tree.nodes[ni], c);
     if (c.left >= 0) {
       uint32_t j = uint32_t(tree.nodes.size());
@@ -108,6 +112,10 @@ inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, Light
       stack.emplace_back(c.left, j);
     }
   }
+}
+
+inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, LightTree& tree) {
+  layoutTree([&](int32_t id) -> const Cluster& { return clusters[size_t(id)]; }, clusters.size(), root, tree);
 }
 
 }  // namespace lc::lightcuts::detail

@@ -133,7 +133,6 @@ class Lightcuts final : public LightEvaluator {
     ShadowResult shadow;  // what the representative's shadow ray found
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
     bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
-    bool probeable;   // large enough for the visibility probes (kProbeMinLights)
   };
 
   static uint64_t heapKey(float bound, uint32_t index) {
@@ -260,13 +259,8 @@ class Lightcuts final : public LightEvaluator {
       float b = luminance(upper);
       if (b > 0) {
         // A node in the heap may be refined next: fetch its children while we work.
-        // Its children's light counts too: a cache miss on every refinement otherwise.
         __builtin_prefetch(&tree.nodes[n.left]);
         __builtin_prefetch(&tree.nodes[n.left + 1]);
-        if (probes) {
-          __builtin_prefetch(&tree.moments[n.left]);
-          __builtin_prefetch(&tree.moments[n.left + 1]);
-        }
         const float lo = luminance(lower);
         float spread = visible && !boundary ? std::max(0.0f, b - lo) : b;
         // Where the contribution is smooth over the cluster and its representative is
@@ -278,8 +272,7 @@ class Lightcuts final : public LightEvaluator {
         const bool scaled = rss && fo && !boundary;
         (scaled ? sumScaled : sumSq) += double(spread) * spread;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
-        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, fo, scaled,
-                                probes && tree.moments[ni].lights >= kProbeMinLights});
+        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, fo, scaled});
       } else if (record) {
         record1(t, ni, found, false);
       }
@@ -291,7 +284,7 @@ class Lightcuts final : public LightEvaluator {
       const LightNode& root = tree.nodes[0];
       ShadowResult shadow;
       Color unit = shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats, shadow,
-                                probes && tree.moments[0].lights >= kProbeMinLights);
+                                probes && tree.lightCount(0) >= kProbeMinLights);
       addNode(t, 0, unit, shadow);
     }
     const float eps = opt_.errorRatio;
@@ -312,7 +305,7 @@ class Lightcuts final : public LightEvaluator {
       sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
       const LightTree& tree = forest_.trees[cn.tree];
       const LightGroup& g = lights_.groups[tree.group];
-      if (cn.probeable && cn.shadow.blocker >= 0 &&
+      if (probes && cn.shadow.blocker >= 0 && tree.lightCount(cn.node) >= kProbeMinLights &&
           hiddenCluster(tree.nodes[cn.node], tree.type, sp, cn.shadow, vis, stats)) {
         // Its representative is hidden, and so is the whole cluster: it stays in the cut,
         // exactly 0, instead of being refined down to its lights.
@@ -332,7 +325,7 @@ class Lightcuts final : public LightEvaluator {
         shadows[k] = cn.shadow;
         units[k] = rep == n.rep ? cn.unit
                                 : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, shadows[k],
-                                               probes && tree.moments[c].lights >= kProbeMinLights);
+                                               probes && tree.lightCount(c) >= kProbeMinLights);
       }
       // A shadow boundary: one child's representative is hidden, the other's not.
       bool boundary = false;
@@ -352,7 +345,7 @@ class Lightcuts final : public LightEvaluator {
       if (cn.firstOrder) {
         const LightTree& tree = forest_.trees[cn.tree];
         const LightNode& n = tree.nodes[cn.node];
-        Color fo = vmax(firstOrderUnit(lights_.lights[n.rep], lights_.groups[tree.group], sp, tree.moments[cn.node],
+        Color fo = vmax(firstOrderUnit(lights_.lights[n.rep], lights_.groups[tree.group], sp, tree.momentsOf(lights_, cn.node),
                                        cn.unit) * n.intensity, Color(0));
         float raw = luminance(cn.estimate), lf = luminance(fo);
         if (raw > 0 && lf > 0) {
@@ -429,7 +422,20 @@ class Lightcuts final : public LightEvaluator {
 class SeedCuts final : public LightEvaluator {
  public:
   SeedCuts(const LightSet& lights, const LightForest& forest, const CutOptions& o)
-      : lights_(lights), forest_(forest), opt_(o) {}
+      : lights_(lights), forest_(forest), opt_(o) {
+    // Trees without the seed's traversal data (agglomerative ones) get it here, once.
+    seed_.resize(forest.trees.size());
+    owned_.reserve(forest.trees.size());
+    for (size_t t = 0; t < forest.trees.size(); ++t) {
+      const LightTree& tree = forest.trees[t];
+      if (tree.seed.size() == tree.nodes.size()) {
+        seed_[t] = tree.seed.data();
+      } else {
+        owned_.push_back(seedNodeData(lights, tree));
+        seed_[t] = owned_.back().data();
+      }
+    }
+  }
 
   EvalResult evaluate(const ShadingPoint& sp, Visibility& vis, EvalStats& stats) const override {
     static thread_local std::vector<std::pair<uint32_t, uint32_t>> stack;
@@ -445,7 +451,7 @@ class SeedCuts final : public LightEvaluator {
       const LightGroup& g = lights_.groups[tree.group];
       const LightNode& n = tree.nodes[ni];
       if (!n.isLeaf()) {
-        const SeedNodeData& sd = tree.seed[ni];
+        const SeedNodeData& sd = seed_[t][ni];
         float dist = tree.type == LightType::Directional ? 1.0f : length(sp.p - sd.position);
         if (sd.error > opt_.errorRatio * dist && cutSize + stack.size() + 2 <= uint32_t(opt_.maxCut)) {
           stack.emplace_back(t, n.left);
@@ -454,13 +460,13 @@ class SeedCuts final : public LightEvaluator {
         }
       }
       bool blocked = false;
-      Color c = nodeLight(tree, g, ni, sp, vis, stats, blocked);
+      Color c = nodeLight(tree, seed_[t], g, ni, sp, vis, stats, blocked);
       if (blocked) {
         // The seed's fallback: a blocked representative may hide lights that are visible;
         // its two children (one level only) stand in for it.
         for (uint32_t k = n.left; k <= n.left + 1; ++k) {
           bool unused;
-          total += nodeLight(tree, g, k, sp, vis, stats, unused);
+          total += nodeLight(tree, seed_[t], g, k, sp, vis, stats, unused);
         }
         cutSize += 2;
         continue;
@@ -477,13 +483,13 @@ class SeedCuts final : public LightEvaluator {
   // The contribution of a node's light: the light itself at a leaf, the synthetic
   // centroid light otherwise (its visibility measured toward the node's representative
   // light). `blocked` is set when an inner node's light is non-zero but fully occluded.
-  Color nodeLight(const LightTree& tree, const LightGroup& g, uint32_t ni, const ShadingPoint& sp,
-                  Visibility& vis, EvalStats& stats, bool& blocked) const {
+  Color nodeLight(const LightTree& tree, const SeedNodeData* seed, const LightGroup& g, uint32_t ni,
+                  const ShadingPoint& sp, Visibility& vis, EvalStats& stats, bool& blocked) const {
     const LightNode& n = tree.nodes[ni];
     blocked = false;
     ShadowResult found;
     if (n.isLeaf()) return shadowedUnit(lights_.lights[n.rep], g, sp, vis, stats, found) * n.intensity;
-    const SeedNodeData& sd = tree.seed[ni];
+    const SeedNodeData& sd = seed[ni];
     Light syn;
     syn.type = tree.type;
     syn.group = tree.group;
@@ -509,6 +515,8 @@ class SeedCuts final : public LightEvaluator {
   const LightSet& lights_;
   const LightForest& forest_;
   CutOptions opt_;
+  std::vector<const SeedNodeData*> seed_;  // per tree: its own or owned_'s
+  std::vector<std::vector<SeedNodeData>> owned_;
 };
 
 }  // namespace

@@ -179,6 +179,28 @@ TEST(SeedCuts, ZeroThresholdReachesEveryLight) {
   EXPECT_NEAR(luminance(a), luminance(b.radiance), 1e-5f * luminance(a));
 }
 
+// The seed's cuts over an agglomerative tree, which stores no seed data: the evaluator
+// computes it, and every cut and value equals the one over the data stored at build time.
+TEST(SeedCuts, OnDemandSeedDataCutsAsStored) {
+  LightSet s = cloud(500, LightType::Oriented, 9);
+  TreeBuildOptions eager;
+  eager.seedData = true;
+  LightForest stored = buildLightForest(s, eager);
+  LightForest lazy = buildLightForest(s);
+  ASSERT_TRUE(lazy.trees[0].seed.empty());
+  auto a = makeSeedCuts(s, stored, CutOptions{0.3f, 1000});
+  auto b = makeSeedCuts(s, lazy, CutOptions{0.3f, 1000});
+  HalfBlocked vis;
+  for (float x : {0.5f, -2.0f, 3.0f}) {
+    ShadingPoint sp = point(Vec3(x, 0.25f, 0));
+    EvalStats sa, sb;
+    EvalResult ra = a->evaluate(sp, vis, sa), rb = b->evaluate(sp, vis, sb);
+    EXPECT_EQ(ra.cutSize, rb.cutSize);
+    EXPECT_EQ(ra.radiance, rb.radiance);
+    EXPECT_EQ(sa.shadowRays, sb.shadowRays);
+  }
+}
+
 TEST(SeedCuts, BlockedRepresentativeFallsBackToChildren) {
   LightSet s;
   s.groups.push_back(LightGroup{});

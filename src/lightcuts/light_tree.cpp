@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <unordered_map>
 #include <stdexcept>
 
 #include "core/error.h"
@@ -91,35 +92,56 @@ double lum(const Color& c) { return 0.2126 * double(c.x) + 0.7152 * double(c.y) 
 
 }  // namespace
 
-void computeMoments(const LightSet& lights, LightTree& tree) {
-  // The luminance-weighted sums of each subtree's positions and axes, in double, divided
-  // once per node: a node's mean is exact to float rounding however many lights it holds
-  // and however deep (a mean of the children's float means loses ~1e-7 per level, which a
-  // long chain of merges adds up). Post-order walk with an explicit stack: memory in the
-  // tree's depth, not its size. A subtree of zero weight takes the plain mean.
-  struct Sums {
-    double w = 0, n = 0;
-    Vec3d pos, axis;    // sum of w x, sum of w n
-    Vec3d posU, axisU;  // unweighted sums
-  };
+namespace {
+
+// Luminance-weighted and plain sums of a subtree's positions and axes, in double.
+struct MomentSums {
+  double w = 0, n = 0;
+  Vec3d pos, axis;    // sum of w x, sum of w n
+  Vec3d posU, axisU;  // unweighted sums
+  void add(const MomentSums& b) {
+    w += b.w;
+    n += b.n;
+    pos += b.pos;
+    axis += b.axis;
+    posU += b.posU;
+    axisU += b.axisU;
+  }
+};
+
+void setMeans(NodeMoments& m, const MomentSums& s) {
+  if (s.w > 0) {
+    m.centroid = (s.pos / s.w).toFloat();
+    m.meanAxis = (s.axis / s.w).toFloat();
+  } else {
+    m.centroid = (s.posU / s.n).toFloat();
+    m.meanAxis = (s.axisU / s.n).toFloat();
+  }
+}
+
+// Post-order walk with an explicit stack (chains of merges can be deep): fills the moments
+// below `top` and returns top's sums. `known(i, sums)` may supply a subtree's sums.
+template <class Known>
+MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, uint32_t top, const Known& known) {
   std::vector<NodeMoments>& m = tree.moments;
-  m.assign(tree.nodes.size(), NodeMoments{});
-  if (tree.nodes.empty()) return;
-  std::vector<std::pair<uint32_t, bool>> stack{{0u, false}};  // node, children done
-  std::vector<Sums> done;  // the finished subtrees whose parent is not
+  std::vector<std::pair<uint32_t, bool>> stack{{top, false}};  // node, children done
+  std::vector<MomentSums> done;  // the finished subtrees whose parent is not
   while (!stack.empty()) {
     auto [i, expanded] = stack.back();
     stack.pop_back();
     const LightNode& n = tree.nodes[i];
+    MomentSums ks;
+    if (!expanded && known(i, ks)) {
+      done.push_back(ks);
+      continue;
+    }
     if (n.isLeaf()) {
-      const Light& l = lights.lights[n.rep];
-      m[i].centroid = l.type == LightType::Directional ? -l.direction : l.position;
-      m[i].meanAxis = l.direction;
-      Sums s;
+      const NodeMoments leaf = tree.momentsOf(lights, i);
+      MomentSums s;
       s.w = lum(n.intensity);
       s.n = 1;
-      s.posU = Vec3d(m[i].centroid);
-      s.axisU = Vec3d(m[i].meanAxis);
+      s.posU = Vec3d(leaf.centroid);
+      s.axisU = Vec3d(leaf.meanAxis);
       s.pos = s.posU * s.w;
       s.axis = s.axisU * s.w;
       done.push_back(s);
@@ -131,34 +153,72 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
       stack.emplace_back(n.left, false);
       continue;
     }
-    Sums b = done.back();
+    MomentSums b = done.back();
     done.pop_back();
-    Sums& s = done.back();  // the left child's, becomes this node's
-    s.w += b.w;
-    s.n += b.n;
-    s.pos += b.pos;
-    s.axis += b.axis;
-    s.posU += b.posU;
-    s.axisU += b.axisU;
-    if (s.w > 0) {
-      m[i].centroid = (s.pos / s.w).toFloat();
-      m[i].meanAxis = (s.axis / s.w).toFloat();
-    } else {
-      m[i].centroid = (s.posU / s.n).toFloat();
-      m[i].meanAxis = (s.axisU / s.n).toFloat();
-    }
-    m[i].lights = m[n.left].lights + m[n.left + 1].lights;
+    done.back().add(b);  // the left child's sums become this node's
+    NodeMoments& mi = m[(n.left - 1) / 2];
+    setMeans(mi, done.back());
+    mi.lights = tree.lightCount(n.left) + tree.lightCount(n.left + 1);
   }
+  return done.back();
+}
+
+}  // namespace
+
+void computeMoments(const LightSet& lights, LightTree& tree) {
+  // The luminance-weighted sums of each subtree's positions and axes, in double, divided
+  // once per node: a node's mean is exact to float rounding however many lights it holds
+  // and however deep (a mean of the children's float means loses ~1e-7 per level, which a
+  // long chain of merges adds up). A subtree of zero weight takes the plain mean. Each
+  // node's sums are its left child's plus its right child's, so the subtrees below the
+  // top levels are summed in parallel to the same values. Memory: the tree's depth.
+  std::vector<NodeMoments>& m = tree.moments;
+  m.assign(tree.nodes.size() / 2, NodeMoments{});  // one per inner node
+  if (tree.nodes.empty()) return;
+  if (tree.preorder.size() != tree.nodes.size()) computePreorder(tree);
+  // Top levels: split down to subtrees of at most kTask lights. A node's light count from
+  // the preorder: the left subtree spans preorder[right] - preorder[left] = 2 count - 1.
+  constexpr uint32_t kTask = 1u << 14;
+  std::vector<uint32_t> tasks;
+  std::unordered_map<uint32_t, uint32_t> taskOf;  // node -> task
+  std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, uint32_t((tree.nodes.size() + 1) / 2)}};
+  while (!stack.empty()) {
+    auto [i, count] = stack.back();
+    stack.pop_back();
+    const LightNode& n = tree.nodes[i];
+    if (n.isLeaf() || count <= kTask) {
+      taskOf.emplace(i, uint32_t(tasks.size()));
+      tasks.push_back(i);
+      continue;
+    }
+    m[(n.left - 1) / 2].lights = count;
+    uint32_t leftCount = (tree.preorder[n.left + 1] - tree.preorder[n.left] + 1) / 2;
+    stack.emplace_back(n.left + 1, count - leftCount);
+    stack.emplace_back(n.left, leftCount);
+  }
+  std::vector<MomentSums> sums(tasks.size());
+  auto none = [](uint32_t, MomentSums&) { return false; };
+  tbb::parallel_for(size_t(0), tasks.size(),
+                    [&](size_t k) { sums[k] = subtreeMoments(lights, tree, tasks[k], none); });
+  subtreeMoments(lights, tree, 0, [&](uint32_t i, MomentSums& s) {
+    auto t = taskOf.find(i);
+    if (t == taskOf.end()) return false;
+    s = sums[t->second];
+    return true;
+  });
 }
 
 void computeSeedData(const LightSet& lights, LightTree& tree) {
-  // Bottom-up, as computeMoments. The mean distance to the centroid is exact for leaves and
+  if (tree.moments.size() != tree.nodes.size() / 2) computeMoments(lights, tree);
+  tree.seed = seedNodeData(lights, tree);
+}
+
+std::vector<SeedNodeData> seedNodeData(const LightSet& lights, const LightTree& tree) {
+  // Bottom-up, from the moments. The mean distance to the centroid is exact for leaves and
   // bounded above through the triangle inequality for inner nodes; the seed builder
   // overwrites it with exact values.
-  if (tree.moments.size() != tree.nodes.size()) computeMoments(lights, tree);
-  std::vector<SeedNodeData>& sd = tree.seed;
+  std::vector<SeedNodeData> sd(tree.nodes.size(), SeedNodeData{});
   std::vector<float> spread(tree.nodes.size(), 0.0f);
-  sd.assign(tree.nodes.size(), SeedNodeData{});
   auto chroma = [](const Color& c) {
     double s = double(c.x) + c.y + c.z;  // in double: the float sum may overflow
     return s > 0 ? Color(float(c.x / s), float(c.y / s), float(c.z / s)) : Color(1.0f / 3);
@@ -166,7 +226,7 @@ void computeSeedData(const LightSet& lights, LightTree& tree) {
   for (size_t i = tree.nodes.size(); i-- > 0;) {
     const LightNode& n = tree.nodes[i];
     SeedNodeData& d = sd[i];
-    const NodeMoments& mo = tree.moments[i];
+    const NodeMoments mo = tree.momentsOf(lights, i);
     d.position = mo.centroid;
     if (n.isLeaf()) {
       d.direction = mo.meanAxis;
@@ -187,6 +247,7 @@ void computeSeedData(const LightSet& lights, LightTree& tree) {
     spread[i] = (wa * (spread[n.left] + ca.x + ca.y + ca.z) + wb * (spread[n.left + 1] + cb.x + cb.y + cb.z)) / w;
     d.error = meanDist * (1 + spread[i]);
   }
+  return sd;
 }
 
 void computePreorder(LightTree& tree) {
@@ -241,9 +302,10 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
         }
       }
       t = buildAgglomerativeTree(lights, idx, k.type, c, seed, std::max<size_t>(options.exactLimit, 2), &progress);
-      computeSeedData(lights, t);
+      // The builder fills the preorder and the moments.
+      if (options.seedData) computeSeedData(lights, t);
     }
-    computePreorder(t);
+    if (t.preorder.size() != t.nodes.size()) computePreorder(t);
     t.type = k.type;
     t.group = k.group;
     forest.trees[i] = std::move(t);

@@ -1,7 +1,9 @@
 // Light trees: binary trees of light clusters. Each node stores what the Lightcuts error
 // bounds need (bounding box, cone of light normals, summed intensity, a representative
-// light) and, in a parallel array, what the seed's traversal needs (intensity-weighted
-// centroid and direction, and its error radius).
+// light) and, in parallel arrays, the first moments and preorder positions that the
+// first-order estimate and the reconstruction cuts need. What the seed's traversal needs
+// (intensity-weighted centroid and direction, and its error radius) the seed builder
+// stores; for other trees the seed's evaluator computes it when it is made.
 //
 // Two builders:
 //   Agglomerative (Walter et al. 2005, built the fast way of Walter et al. 2008): greedily
@@ -57,12 +59,30 @@ struct LightTree {
   LightType type = LightType::Omni;
   uint16_t group = 0;
   std::vector<LightNode> nodes;  // nodes[0] is the root
-  std::vector<SeedNodeData> seed;  // parallel to nodes
-  std::vector<NodeMoments> moments;  // parallel to nodes
+  // Parallel to nodes when filled: the seed builder fills it; agglomerative trees leave it
+  // empty (unless TreeBuildOptions::seedData) and makeSeedCuts computes it on demand.
+  std::vector<SeedNodeData> seed;
+  // Per inner node, at (left - 1) / 2: sibling pairs sit at nodes 1-2, 3-4, ..., so that is
+  // each inner node's own slot (n - 1 of them). A leaf's moments are its light's
+  // (momentsOf); storing them would repeat the light (28 bytes per light).
+  std::vector<NodeMoments> moments;
   // Parallel to nodes: each node's position in a depth-first walk that visits the left
   // child (n.left) before the right one, so a subtree is a contiguous range. Reconstruction
   // cuts (reconstruction.h) compare cuts of different points by it.
   std::vector<uint32_t> preorder;
+
+  // Node i's moments: stored for inner nodes, made from the light for a leaf.
+  NodeMoments momentsOf(const LightSet& lights, uint32_t i) const {
+    const LightNode& n = nodes[i];
+    if (!n.isLeaf()) return moments[(n.left - 1) / 2];
+    const Light& l = lights.lights[n.rep];
+    return NodeMoments{l.type == LightType::Directional ? -l.direction : l.position, l.direction, 1};
+  }
+  // How many lights node i holds.
+  uint32_t lightCount(uint32_t i) const {
+    const LightNode& n = nodes[i];
+    return n.isLeaf() ? 1u : moments[(n.left - 1) / 2].lights;
+  }
 };
 
 enum class TreeBuilder { Agglomerative, Seed };
@@ -77,6 +97,9 @@ struct TreeBuildOptions {
   // the diagonal of the tree's own lights (for callers that know no scene).
   float sceneDiagonal = 0;
   ProgressFn progress = {};  // called with the share of lights clustered (core/progress.h)
+  // Agglomerative trees: fill LightTree::seed as well (56 bytes per light that only
+  // --method seed reads; makeSeedCuts computes the same data when it is missing).
+  bool seedData = false;
 };
 
 struct LightForest {
@@ -124,5 +147,7 @@ void computeMoments(const LightSet& lights, LightTree& tree);
 // Fills LightTree::seed from the finished nodes and their moments (centroids, mean
 // directions, errors).
 void computeSeedData(const LightSet& lights, LightTree& tree);
+// The same data, for a tree that has its moments, without touching the tree.
+std::vector<SeedNodeData> seedNodeData(const LightSet& lights, const LightTree& tree);
 
 }  // namespace lc::lightcuts

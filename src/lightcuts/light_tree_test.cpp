@@ -80,7 +80,31 @@ TEST_P(TreeBuild, IsAValidClusterHierarchy) {
     LightForest f = buildLightForest(set, TreeBuildOptions{builder, 5});
     ASSERT_EQ(f.trees.size(), 1u);
     checkTree(set, f.trees[0]);
-    ASSERT_EQ(f.trees[0].seed.size(), f.trees[0].nodes.size());
+    ASSERT_EQ(f.trees[0].moments.size(), f.trees[0].nodes.size() / 2);  // inner nodes only
+    // Only the seed builder stores the seed's traversal data; others leave it to makeSeedCuts.
+    ASSERT_EQ(f.trees[0].seed.size(), builder == TreeBuilder::Seed ? f.trees[0].nodes.size() : 0u);
+  }
+}
+
+// The seed's traversal data that agglomerative trees no longer store: computed on demand,
+// it equals what the build used to store, field for field.
+TEST(TreeBuild, SeedDataOnDemandEqualsEager) {
+  for (LightType type : {LightType::Omni, LightType::Oriented, LightType::Directional}) {
+    LightSet set = randomLights(3000, type, 21, true);
+    TreeBuildOptions eager{TreeBuilder::Agglomerative, 5};
+    eager.seedData = true;
+    LightForest a = buildLightForest(set, eager);
+    LightForest b = buildLightForest(set, TreeBuildOptions{TreeBuilder::Agglomerative, 5});
+    ASSERT_EQ(a.trees[0].seed.size(), a.trees[0].nodes.size());
+    ASSERT_TRUE(b.trees[0].seed.empty());
+    EXPECT_LT(b.memoryBytes(), a.memoryBytes());
+    std::vector<SeedNodeData> lazy = seedNodeData(set, b.trees[0]);
+    ASSERT_EQ(lazy.size(), a.trees[0].seed.size());
+    for (size_t i = 0; i < lazy.size(); ++i) {
+      ASSERT_EQ(lazy[i].position, a.trees[0].seed[i].position) << i;
+      ASSERT_EQ(lazy[i].direction, a.trees[0].seed[i].direction) << i;
+      ASSERT_EQ(lazy[i].error, a.trees[0].seed[i].error) << i;
+    }
   }
 }
 
@@ -124,6 +148,84 @@ TEST(TreeBuild, SkipsLightsWithoutIntensity) {
   set.lights[3].intensity = Color(0);
   LightForest f = buildLightForest(set);
   EXPECT_EQ(leafCount(f.trees[0], 0), 9u);
+}
+
+// computeMoments as it was, serial: the reference for the parallel one.
+std::vector<NodeMoments> serialMoments(const LightSet& lights, const LightTree& tree) {
+  struct Sums {
+    double w = 0, n = 0;
+    Vec3d pos, axis, posU, axisU;
+  };
+  std::vector<NodeMoments> m(tree.nodes.size());
+  std::vector<std::pair<uint32_t, bool>> stack{{0u, false}};
+  std::vector<Sums> done;
+  while (!stack.empty()) {
+    auto [i, expanded] = stack.back();
+    stack.pop_back();
+    const LightNode& n = tree.nodes[i];
+    if (n.isLeaf()) {
+      const Light& l = lights.lights[n.rep];
+      m[i].centroid = l.type == LightType::Directional ? -l.direction : l.position;
+      m[i].meanAxis = l.direction;
+      Sums s;
+      s.w = 0.2126 * double(n.intensity.x) + 0.7152 * double(n.intensity.y) + 0.0722 * double(n.intensity.z);  // as computeMoments: in double
+      s.n = 1;
+      s.posU = Vec3d(m[i].centroid);
+      s.axisU = Vec3d(m[i].meanAxis);
+      s.pos = s.posU * s.w;
+      s.axis = s.axisU * s.w;
+      done.push_back(s);
+      continue;
+    }
+    if (!expanded) {
+      stack.emplace_back(i, true);
+      stack.emplace_back(n.left + 1, false);
+      stack.emplace_back(n.left, false);
+      continue;
+    }
+    Sums b = done.back();
+    done.pop_back();
+    Sums& s = done.back();
+    s.w += b.w;
+    s.n += b.n;
+    s.pos += b.pos;
+    s.axis += b.axis;
+    s.posU += b.posU;
+    s.axisU += b.axisU;
+    Vec3d c = s.w > 0 ? s.pos / s.w : s.posU / s.n, a = s.w > 0 ? s.axis / s.w : s.axisU / s.n;
+    m[i].centroid = c.toFloat();
+    m[i].meanAxis = a.toFloat();
+    m[i].lights = m[n.left].lights + m[n.left + 1].lights;
+  }
+  return m;
+}
+
+// The agglomerative builder lays the tree out and numbers it in preorder in one pass, and
+// sums the moments in parallel, large subtrees side by side: the same values, bit for bit,
+// as the serial passes (computePreorder; computeMoments as it was).
+TEST(Agglomerative, ParallelLayoutAndMomentsEqualSerialPasses) {
+  for (LightType type : {LightType::Omni, LightType::Oriented, LightType::Directional}) {
+    LightSet set = randomLights(50000, type, 33, true);
+    set.lights[7].intensity = Color(0, 0, 0);  // skipped
+    set.lights[8].intensity = Color(1e-30f, 0, 0);  // weight rounds to ~0 in float
+    TreeBuildOptions o{TreeBuilder::Agglomerative, 5};
+    o.exactLimit = 512;  // chunks bottom-up, then the exact top; subtrees over 2^14 lights
+    LightForest f = buildLightForest(set, o);
+    const LightTree& t = f.trees[0];
+    checkTree(set, t);
+    LightTree again = t;
+    computePreorder(again);
+    std::vector<NodeMoments> ref = serialMoments(set, t);
+    ASSERT_EQ(t.nodes.size(), ref.size());
+    for (uint32_t i = 0; i < t.nodes.size(); ++i) {
+      const NodeMoments got = t.momentsOf(set, i);
+      ASSERT_EQ(got.centroid, ref[i].centroid) << i;
+      ASSERT_EQ(got.meanAxis, ref[i].meanAxis) << i;
+      ASSERT_EQ(got.lights, ref[i].lights) << i;
+      ASSERT_EQ(t.lightCount(i), ref[i].lights) << i;
+      ASSERT_EQ(t.preorder[i], again.preorder[i]) << i;
+    }
+  }
 }
 
 // Agglomerative clustering must merge the two obvious groups last.
@@ -342,7 +444,7 @@ TEST(Precision, MomentsOfAMillionLevelChainAreExact) {
   }
   computeMoments(s, t);
   for (uint32_t j : {0u, 1u, 1000u, kN / 2, kN - 10}) {
-    const NodeMoments& m = t.moments[2 * j];
+    const NodeMoments m = t.momentsOf(s, 2 * j);
     const double want = (double(j) + double(kN - 1)) / (2.0 * kN);
     EXPECT_NEAR(m.centroid.x, want, 1e-6 * want) << "node of the suffix from light " << j;
     EXPECT_EQ(m.lights, kN - j);

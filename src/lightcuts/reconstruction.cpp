@@ -100,7 +100,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         // so, the coarser cut will do.
         const uint8_t vf = uint8_t(CutVisibility::Visible) | kFirstOrderBit;
         bool kept = false, ok = true;
-        const uint32_t last = pre + 2 * tree.moments[it.node].lights - 1;  // the subtree's preorder range
+        const uint32_t last = pre + 2 * tree.lightCount(it.node) - 1;  // the subtree's preorder range
         uint32_t past[kMaxSamples];  // per refining sample: its first entry after the subtree
         for (int i = 0; i < count && ok; ++i) {
           if (it.state[i] == kAbove) continue;
