@@ -23,6 +23,7 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
   } else {
     io::ParseOptions po;
     po.lenient = o.lenient;
+    po.emissionDensity = o.emissionDensity;
     po.limits = o.limits;
     desc = io::parseRayFile(path, po);
   }

@@ -18,6 +18,8 @@ struct LoadOptions {
   bool lenient = false;
   Limits limits;
   int threads = 0;
+  // io::ParseOptions: --emission-density (.ray files).
+  float emissionDensity = 1;
   lights::ObjectLightOptions objectLights;
   // Instant radiosity: command-line values override the scene's instant_radiosity block.
   std::optional<int> vplCount, bounces;

@@ -29,6 +29,9 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
      return true;
    }, "Where object lights go: stratified (area-uniform low-discrepancy, default) or seed (the seed's pattern)")
       ->check(CLI::IsMember({"stratified", "seed"}));
+  c.add_option_function<float>("--emission-density", [&o](const float& v) { o.emissionDensity = v; },
+                               "Point lights per unit of world area for `emission = (r,g,b)` object lights (default 1)")
+      ->check(CLI::Range(0.0f, 1e30f));
   c.add_option_function<int>("--vpls", [&o](const int& v) { o.vplCount = v; },
                              "Instant radiosity: number of light paths shot for virtual point lights (overrides the scene)")
       ->check(CLI::Range(0, 1 << 30));

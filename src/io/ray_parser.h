@@ -14,6 +14,9 @@ struct ParseOptions {
   // instead of being errors.
   bool lenient = false;
   Limits limits;
+  // `emission = Le` (COMP4411): point lights per unit of world area of the object light it
+  // makes (--emission-density).
+  float emissionDensity = 1;
 };
 
 // Parses a .ray file. Relative paths inside (textures, obj_mesh) resolve against its directory.
