@@ -24,6 +24,7 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
     io::ParseOptions po;
     po.lenient = o.lenient;
     po.emissionDensity = o.emissionDensity;
+    po.defaultAttenuation = o.defaultAttenuation;
     po.limits = o.limits;
     desc = io::parseRayFile(path, po);
   }

@@ -703,8 +703,8 @@ void Parser::addLight(LightDesc&& l, const Token& kw) {
 //                     blend = 0..1 (penumbra = blend * cone angle, applied at the '}');
 //                     cutoff_distance = d > 0: no light beyond d (default infinite) }
 // Attenuation: constant/linear/quadratic_attenuation_coeff >= 0, default 0, 0, 1
-//
-// (point and spot lights). The last of direction / target decides the spot axis.
+// (point and spot lights); a light that sets none of the three takes --default-attenuation
+// when given. The last of direction / target decides the spot axis.
 void Parser::light(const Token& kw) {
   const std::string kind = kw.word;
   LightDesc l;
@@ -717,6 +717,7 @@ void Parser::light(const Token& kw) {
   bool haveTarget = false;
   std::optional<float> size, blend;
   Token targetTok, blendTok;
+  bool anyAtten = false;
   block(kind, [&](const Token& k) {
     const std::string& w = k.word;
     if (w == "color") {
@@ -737,12 +738,15 @@ void Parser::light(const Token& kw) {
       haveTarget = true;
     } else if (w == "constant_attenuation_coeff" && positional) {
       expectEquals();
+      anyAtten = true;
       l.attenConstant = nonNegative("constant_attenuation_coeff");
     } else if (w == "linear_attenuation_coeff" && positional) {
       expectEquals();
+      anyAtten = true;
       l.attenLinear = nonNegative("linear_attenuation_coeff");
     } else if (w == "quadratic_attenuation_coeff" && positional) {
       expectEquals();
+      anyAtten = true;
       l.attenQuadratic = nonNegative("quadratic_attenuation_coeff");
     } else if (w == "exponent" && spot) {
       expectEquals();
@@ -780,6 +784,11 @@ void Parser::light(const Token& kw) {
   if (haveTarget) {
     l.direction = target - l.position;
     if (length2(l.direction) == 0) fail(targetTok, "target must differ from the light position");
+  }
+  if (positional && !anyAtten && opt_.defaultAttenuation) {
+    l.attenConstant = (*opt_.defaultAttenuation)[0];
+    l.attenLinear = (*opt_.defaultAttenuation)[1];
+    l.attenQuadratic = (*opt_.defaultAttenuation)[2];
   }
   if (size) l.coneAngleDegrees = *size / 2;
   if (blend) {

@@ -1380,5 +1380,29 @@ TEST(RayParserEmission, Errors) {
             "t.ray:2:36: error: unknown keyword 'material' in sphere_light");
 }
 
+TEST(RayParserLights, DefaultAttenuation) {
+  const std::string body =
+      "point_light { position = (0, 0, 1); }\n"
+      "point_light { position = (0, 0, 1); linear_attenuation_coeff = 0.5; }\n"
+      "spot_light { position = (0, 0, 1); direction = (0, 0, -1); }\n"
+      "directional_light { direction = (0, 0, -1); }\n";
+  SceneDesc plain = parse(body);
+  EXPECT_EQ(plain.lights[0].attenConstant, 0);
+  EXPECT_EQ(plain.lights[0].attenQuadratic, 1);
+  ParseOptions o;
+  o.defaultAttenuation = std::array<float, 3>{0.25f, 0.25f, 0.25f};
+  SceneDesc s = parse(body, o);
+  ASSERT_EQ(s.lights.size(), 4u);
+  for (size_t i : {size_t(0), size_t(2)}) {
+    EXPECT_EQ(s.lights[i].attenConstant, 0.25f) << i;
+    EXPECT_EQ(s.lights[i].attenLinear, 0.25f) << i;
+    EXPECT_EQ(s.lights[i].attenQuadratic, 0.25f) << i;
+  }
+  // A light that sets any coefficient keeps the format's defaults for the others.
+  EXPECT_EQ(s.lights[1].attenConstant, 0);
+  EXPECT_EQ(s.lights[1].attenLinear, 0.5f);
+  EXPECT_EQ(s.lights[1].attenQuadratic, 1);
+}
+
 }  // namespace
 }  // namespace lc::io
