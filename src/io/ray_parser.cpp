@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <unordered_map>
 
 #include "core/file_util.h"
@@ -228,6 +229,10 @@ class Parser {
   std::vector<Frame> frames_;                    // open transforms and groups
   uint64_t totalVertices_ = 0, totalTriangles_ = 0;
   Token cameraToken_;
+  // PBR material keys accepted and ignored (type, metallic, roughness, translucency): how
+  // often each was seen, and where the first was; one summary warning at the end.
+  std::map<std::string, int> ignoredPbr_;
+  std::optional<SourceLoc> firstPbr_;
 };
 
 // ---------------------------------------------------------------------------------------
@@ -451,6 +456,13 @@ SceneDesc Parser::run() {
     else if (w == "instant_radiosity") instantRadiosity(kw);
     else unknown(kw, "");
   }
+  if (!ignoredPbr_.empty()) {
+    std::string keys;
+    for (const auto& [k, n] : ignoredPbr_)
+      keys += (keys.empty() ? "" : ", ") + k + (n > 1 ? " (x" + std::to_string(n) + ")" : "");
+    scene_.warnings.push_back(firstPbr_->str() + ": warning: PBR material keys ignored (shading is Phong; " +
+                              "`albedo` is read as diffuse): " + keys);
+  }
   return std::move(scene_);
 }
 
@@ -489,11 +501,16 @@ int Parser::materialValue(int baseIndex) {
 //   luminosity = { ... }    makes objects with this material lights (see luminosity())
 //   emission = (r,g,b)      COMP4411: radiance Le; emissive = Le and a per-area luminosity
 //                           (see applyEmission())
+//   albedo = c              PBR (COMP4411 microfacet): the diffuse colour when the block
+//                           sets no `diffuse`
+//   type, metallic, roughness, translucency   PBR: accepted, ignored (one summary warning)
 int Parser::materialBlock(int baseIndex) {
   checkItemLimit(lex_.peek());
   MaterialDesc m = scene_.materials[size_t(baseIndex)];
   m.name.clear();
   m.loc = lex_.loc(lex_.peek());
+  bool haveDiffuse = false;
+  std::optional<ColorParam> albedo;
   block("material", [&](const Token& k) {
     const std::string& w = k.word;
     auto colour = [&](ColorParam& c) {
@@ -507,9 +524,17 @@ int Parser::materialBlock(int baseIndex) {
       colour(m.ambient);
     } else if (w == "diffuse") {
       colour(m.diffuse);
+      haveDiffuse = true;
+    } else if (w == "albedo") {
+      expectEquals();
+      albedo = colorValue();
     } else if (w == "emission") {
       expectEquals();
       applyEmission(m, emissionValue(), k);
+    } else if (oneOf(w, {"type", "metallic", "roughness", "translucency"})) {
+      ++ignoredPbr_[w];
+      if (!firstPbr_) firstPbr_ = lex_.loc(k);
+      skipValue();
     } else if (w == "specular") {
       colour(m.specular);
     } else if (w == "reflective") {
@@ -543,6 +568,7 @@ int Parser::materialBlock(int baseIndex) {
     }
     return true;
   });
+  if (albedo && !haveDiffuse) m.diffuse = *albedo;
   int index = int(scene_.materials.size());
   if (!m.name.empty()) named_[m.name] = index;
   scene_.materials.push_back(std::move(m));

@@ -1380,6 +1380,20 @@ TEST(RayParserEmission, Errors) {
             "t.ray:2:36: error: unknown keyword 'material' in sphere_light");
 }
 
+TEST(RayParserPbr, AlbedoAndIgnoredKeys) {
+  SceneDesc s = parse(
+      "sphere { material = { type = \"microfacet\"; albedo = (0.2, 0.4, 0.6); metallic = 0.5;\n"
+      "  roughness = 0.3; }; }\n"
+      "sphere { material = { albedo = (0.9, 0.9, 0.9); diffuse = (0.1, 0.1, 0.1); roughness = 0.1;\n"
+      "  translucency = 0.2; type = \"fresnel\"; }; }\n");
+  expectVec(materialOf(s, 0).diffuse.value, 0.2f, 0.4f, 0.6f);
+  expectVec(materialOf(s, 1).diffuse.value, 0.1f, 0.1f, 0.1f);  // diffuse wins over albedo
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0],
+            "t.ray:2:23: warning: PBR material keys ignored (shading is Phong; `albedo` is read as "
+            "diffuse): metallic, roughness (x2), translucency, type (x2)");
+}
+
 TEST(RayParserLights, DefaultAttenuation) {
   const std::string body =
       "point_light { position = (0, 0, 1); }\n"
