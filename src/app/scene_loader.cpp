@@ -23,6 +23,8 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
   } else {
     io::ParseOptions po;
     po.lenient = o.lenient;
+    po.emissionDensity = o.emissionDensity;
+    po.defaultAttenuation = o.defaultAttenuation;
     po.limits = o.limits;
     desc = io::parseRayFile(path, po);
   }

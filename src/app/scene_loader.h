@@ -2,6 +2,7 @@
 // add the generated lights (object lights, VPLs), timing each phase.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,6 +19,9 @@ struct LoadOptions {
   bool lenient = false;
   Limits limits;
   int threads = 0;
+  // io::ParseOptions: --emission-density and --default-attenuation (.ray files).
+  float emissionDensity = 1;
+  std::optional<std::array<float, 3>> defaultAttenuation;
   lights::ObjectLightOptions objectLights;
   // Instant radiosity: command-line values override the scene's instant_radiosity block.
   std::optional<int> vplCount, bounces;

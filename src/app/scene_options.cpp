@@ -1,5 +1,8 @@
 #include "app/scene_options.h"
 
+#include <cmath>
+#include <sstream>
+
 namespace lc::app {
 
 namespace {
@@ -29,6 +32,24 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
      return true;
    }, "Where object lights go: stratified (area-uniform low-discrepancy, default) or seed (the seed's pattern)")
       ->check(CLI::IsMember({"stratified", "seed"}));
+  c.add_option_function<float>("--emission-density", [&o](const float& v) { o.emissionDensity = v; },
+                               "Point lights per unit of world area for `emission = (r,g,b)` object lights (default 1)")
+      ->check(CLI::Range(0.0f, 1e30f));
+  c.add_option("--default-attenuation", [&o](const CLI::results_t& r) {
+     std::array<float, 3> a{};
+     std::string s = r[0];
+     for (char& ch : s)
+       if (ch == ',') ch = ' ';
+     std::istringstream in(s);
+     std::string extra;
+     for (float& v : a)
+       if (!(in >> v) || !std::isfinite(v) || v < 0) return false;
+     if (in >> extra) return false;
+     o.defaultAttenuation = a;
+     return true;
+   }, "Attenuation A,B,C (constant, linear, quadratic; each >= 0) of point and spot lights that set none "
+      "(the UW renderer's sliders)")
+      ->type_name("A,B,C");
   c.add_option_function<int>("--vpls", [&o](const int& v) { o.vplCount = v; },
                              "Instant radiosity: number of light paths shot for virtual point lights (overrides the scene)")
       ->check(CLI::Range(0, 1 << 30));

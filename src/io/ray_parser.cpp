@@ -3,6 +3,7 @@
 // only by Limits::maxNesting and never by the C++ stack.
 #include "io/ray_parser.h"
 
+#include <algorithm>
 #include <cfloat>
 #include <charconv>
 #include <cerrno>
@@ -11,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <unordered_map>
 
 #include "core/file_util.h"
@@ -77,7 +79,7 @@ bool isPrimitiveWord(const Token& t) {
   if (t.kind != TokenKind::Ident || t.quoted) return false;
   const std::string& w = t.word;
   return w == "sphere" || w == "box" || w == "square" || w == "cylinder" || w == "cone" ||
-         w == "trimesh" || w == "obj_mesh";
+         w == "trimesh" || w == "obj_mesh" || w == "sphere_light";
 }
 
 bool isTopLevelOnlyWord(const Token& t) {
@@ -197,6 +199,14 @@ class Parser {
   void primitive(const Token& kw);
   void trimesh(const Token& kw, ObjectDesc& obj);
   void objMesh(const Token& kw, ObjectDesc& obj);
+  void sphereLight(const Token& kw, ObjectDesc& obj);
+  // `emission = (r,g,b)`: reads the value (after the key), components finite and >= 0.
+  Color emissionValue();
+  // Makes `m` emit radiance `le`: emissive = le (the camera sees it) and a per-area
+  // luminosity { colour = le; intensity = 1; per_area; density = --emission-density }.
+  void applyEmission(MaterialDesc& m, const Color& le, const Token& at) const;
+  // A copy of material `index` (unnamed) with `emission = le` applied; returns its index.
+  int emissiveCopy(int index, const Color& le, const Token& at);
   void addLight(LightDesc&& l, const Token& kw);
   void checkMeshLimits(const Token& at, uint64_t vertices, uint64_t triangles) const;
 
@@ -219,6 +229,10 @@ class Parser {
   std::vector<Frame> frames_;                    // open transforms and groups
   uint64_t totalVertices_ = 0, totalTriangles_ = 0;
   Token cameraToken_;
+  // PBR material keys accepted and ignored (type, metallic, roughness, translucency): how
+  // often each was seen, and where the first was; one summary warning at the end.
+  std::map<std::string, int> ignoredPbr_;
+  std::optional<SourceLoc> firstPbr_;
 };
 
 // ---------------------------------------------------------------------------------------
@@ -442,6 +456,13 @@ SceneDesc Parser::run() {
     else if (w == "instant_radiosity") instantRadiosity(kw);
     else unknown(kw, "");
   }
+  if (!ignoredPbr_.empty()) {
+    std::string keys;
+    for (const auto& [k, n] : ignoredPbr_)
+      keys += (keys.empty() ? "" : ", ") + k + (n > 1 ? " (x" + std::to_string(n) + ")" : "");
+    scene_.warnings.push_back(firstPbr_->str() + ": warning: PBR material keys ignored (shading is Phong; " +
+                              "`albedo` is read as diffuse): " + keys);
+  }
   return std::move(scene_);
 }
 
@@ -478,11 +499,18 @@ int Parser::materialValue(int baseIndex) {
 //   index = s | map()       refractive index > 0, default 1
 //   name x | name = "x"     declares the material for later `material = x`
 //   luminosity = { ... }    makes objects with this material lights (see luminosity())
+//   emission = (r,g,b)      COMP4411: radiance Le; emissive = Le and a per-area luminosity
+//                           (see applyEmission())
+//   albedo = c              PBR (COMP4411 microfacet): the diffuse colour when the block
+//                           sets no `diffuse`
+//   type, metallic, roughness, translucency   PBR: accepted, ignored (one summary warning)
 int Parser::materialBlock(int baseIndex) {
   checkItemLimit(lex_.peek());
   MaterialDesc m = scene_.materials[size_t(baseIndex)];
   m.name.clear();
   m.loc = lex_.loc(lex_.peek());
+  bool haveDiffuse = false;
+  std::optional<ColorParam> albedo;
   block("material", [&](const Token& k) {
     const std::string& w = k.word;
     auto colour = [&](ColorParam& c) {
@@ -496,6 +524,17 @@ int Parser::materialBlock(int baseIndex) {
       colour(m.ambient);
     } else if (w == "diffuse") {
       colour(m.diffuse);
+      haveDiffuse = true;
+    } else if (w == "albedo") {
+      expectEquals();
+      albedo = colorValue();
+    } else if (w == "emission") {
+      expectEquals();
+      applyEmission(m, emissionValue(), k);
+    } else if (oneOf(w, {"type", "metallic", "roughness", "translucency"})) {
+      ++ignoredPbr_[w];
+      if (!firstPbr_) firstPbr_ = lex_.loc(k);
+      skipValue();
     } else if (w == "specular") {
       colour(m.specular);
     } else if (w == "reflective") {
@@ -529,6 +568,7 @@ int Parser::materialBlock(int baseIndex) {
     }
     return true;
   });
+  if (albedo && !haveDiffuse) m.diffuse = *albedo;
   int index = int(scene_.materials.size());
   if (!m.name.empty()) named_[m.name] = index;
   scene_.materials.push_back(std::move(m));
@@ -538,6 +578,7 @@ int Parser::materialBlock(int baseIndex) {
 // luminosity = { colour|color = (r,g,b) | map("file") | texture;   default (1,1,1)
 //                intensity = total power >= 0 (default 1);
 //                density = point lights per unit area >= 0 (default 1);
+//                per_area = true|false: intensity per unit of world area (default false);
 //                constant/linear/quadratic_attenuation_coeff >= 0 (default 0, 0, 1); }
 // Starts from these defaults (not from the default material's luminosity).
 LuminosityDesc Parser::luminosity(const Token& key) {
@@ -546,7 +587,7 @@ LuminosityDesc Parser::luminosity(const Token& key) {
   l.loc = lex_.loc(key);
   block("luminosity", [&](const Token& k) {
     const std::string& w = k.word;
-    if (!oneOf(w, {"color", "intensity", "density", "constant_attenuation_coeff",
+    if (!oneOf(w, {"color", "intensity", "density", "per_area", "constant_attenuation_coeff",
                    "linear_attenuation_coeff", "quadratic_attenuation_coeff"}))
       return false;
     expectEquals();
@@ -563,6 +604,8 @@ LuminosityDesc Parser::luminosity(const Token& key) {
       l.intensity = nonNegative("intensity");
     } else if (w == "density") {
       l.density = nonNegative("density");
+    } else if (w == "per_area") {
+      l.perArea = boolValue();
     } else if (w == "constant_attenuation_coeff") {
       l.attenConstant = nonNegative("constant_attenuation_coeff");
     } else if (w == "linear_attenuation_coeff") {
@@ -686,7 +729,8 @@ void Parser::addLight(LightDesc&& l, const Token& kw) {
 //                     blend = 0..1 (penumbra = blend * cone angle, applied at the '}');
 //                     cutoff_distance = d > 0: no light beyond d (default infinite) }
 // Attenuation: constant/linear/quadratic_attenuation_coeff >= 0, default 0, 0, 1
-// (point and spot lights). The last of direction / target decides the spot axis.
+// (point and spot lights); a light that sets none of the three takes --default-attenuation
+// when given. The last of direction / target decides the spot axis.
 void Parser::light(const Token& kw) {
   const std::string kind = kw.word;
   LightDesc l;
@@ -699,6 +743,7 @@ void Parser::light(const Token& kw) {
   bool haveTarget = false;
   std::optional<float> size, blend;
   Token targetTok, blendTok;
+  bool anyAtten = false;
   block(kind, [&](const Token& k) {
     const std::string& w = k.word;
     if (w == "color") {
@@ -719,12 +764,15 @@ void Parser::light(const Token& kw) {
       haveTarget = true;
     } else if (w == "constant_attenuation_coeff" && positional) {
       expectEquals();
+      anyAtten = true;
       l.attenConstant = nonNegative("constant_attenuation_coeff");
     } else if (w == "linear_attenuation_coeff" && positional) {
       expectEquals();
+      anyAtten = true;
       l.attenLinear = nonNegative("linear_attenuation_coeff");
     } else if (w == "quadratic_attenuation_coeff" && positional) {
       expectEquals();
+      anyAtten = true;
       l.attenQuadratic = nonNegative("quadratic_attenuation_coeff");
     } else if (w == "exponent" && spot) {
       expectEquals();
@@ -762,6 +810,11 @@ void Parser::light(const Token& kw) {
   if (haveTarget) {
     l.direction = target - l.position;
     if (length2(l.direction) == 0) fail(targetTok, "target must differ from the light position");
+  }
+  if (positional && !anyAtten && opt_.defaultAttenuation) {
+    l.attenConstant = (*opt_.defaultAttenuation)[0];
+    l.attenLinear = (*opt_.defaultAttenuation)[1];
+    l.attenQuadratic = (*opt_.defaultAttenuation)[2];
   }
   if (size) l.coneAngleDegrees = *size / 2;
   if (blend) {
@@ -1004,7 +1057,9 @@ Mat4 Parser::transformArgs(const Token& kw) {
 //   cylinder  radius 1 about z, z in [0,1]; capped = true|false (default true)
 //   cone      along +z: height > 0 (1), bottom_radius >= 0 (1), top_radius >= 0 (0),
 //             capped (true); the radii must not both be 0
-//   trimesh / polymesh, obj_mesh: see trimesh() and objMesh()
+//   trimesh / polymesh, obj_mesh, sphere_light: see trimesh(), objMesh(), sphereLight()
+//   emission = (r,g,b)  COMP4411: radiance Le; the object gets a copy of its material with
+//             emission applied (see applyEmission())
 void Parser::primitive(const Token& kw) {
   checkItemLimit(kw);
   ObjectDesc obj;
@@ -1014,17 +1069,24 @@ void Parser::primitive(const Token& kw) {
   const std::string& w = kw.word;
   if (w == "trimesh") return trimesh(kw, obj);
   if (w == "obj_mesh") return objMesh(kw, obj);
+  if (w == "sphere_light") return sphereLight(kw, obj);
   obj.kind = w == "sphere" ? ShapeKind::Sphere
              : w == "box"      ? ShapeKind::Box
              : w == "square"   ? ShapeKind::Square
              : w == "cylinder" ? ShapeKind::Cylinder
                                : ShapeKind::Cone;
   bool cyl = obj.kind == ShapeKind::Cylinder, cone = obj.kind == ShapeKind::Cone;
+  std::optional<Color> emission;
+  Token emissionTok;
   block(kw.text, [&](const Token& k) {
     const std::string& a = k.word;
     if (a == "material") {
       expectEquals();
       obj.material = materialValue(defaultMat_);
+    } else if (a == "emission") {
+      expectEquals();
+      emissionTok = k;
+      emission = emissionValue();
     } else if (a == "name") {
       obj.name = nameValue().text;
     } else if (a == "capped" && (cyl || cone)) {
@@ -1046,6 +1108,83 @@ void Parser::primitive(const Token& kw) {
   });
   if (cone && obj.bottomRadius == 0 && obj.topRadius == 0)
     fail(kw, "cone has bottom_radius and top_radius both 0");
+  if (emission) obj.material = emissiveCopy(obj.material, *emission, emissionTok);
+  scene_.objects.push_back(std::move(obj));
+}
+
+Color Parser::emissionValue() {
+  Token open;
+  Vec3 v = vec3(&open);
+  for (int i = 0; i < 3; ++i)
+    if (!(v[i] >= 0) || !std::isfinite(v[i]))
+      fail(open, "emission components must be finite and >= 0");
+  return v;
+}
+
+void Parser::applyEmission(MaterialDesc& m, const Color& le, const Token& at) const {
+  m.emissive = ColorParam{le, std::nullopt};
+  m.emissiveSet = true;
+  if (!(std::max({le.x, le.y, le.z}) > 0)) {
+    m.luminosity.reset();  // emission = (0,0,0): not a light
+    return;
+  }
+  LuminosityDesc l;
+  l.colour = ColorParam{le, std::nullopt};
+  l.intensity = 1;
+  l.perArea = true;
+  l.density = opt_.emissionDensity;
+  l.loc = lex_.loc(at);
+  m.luminosity = l;
+}
+
+int Parser::emissiveCopy(int index, const Color& le, const Token& at) {
+  checkItemLimit(at);
+  MaterialDesc m = scene_.materials[size_t(index)];
+  m.name.clear();
+  applyEmission(m, le, at);
+  scene_.materials.push_back(std::move(m));
+  return int(scene_.materials.size()) - 1;
+}
+
+// sphere_light { emission = (r,g,b) (required); radius = r > 0 (default 1); name = x; }
+// (COMP4411): a sphere of radius r at the origin of the current transform, as COMP4411's
+// SphereLight (a unit Sphere under the transform). Its material is the all-black initial
+// material with `emission` applied, so it is an object light of radiance Le that the camera
+// sees at Le.
+void Parser::sphereLight(const Token& kw, ObjectDesc& obj) {
+  std::optional<Color> emission;
+  Token emissionTok;
+  float radius = 1;
+  Token radiusTok = kw;
+  block("sphere_light", [&](const Token& k) {
+    const std::string& a = k.word;
+    if (a == "emission") {
+      expectEquals();
+      emissionTok = k;
+      emission = emissionValue();
+    } else if (a == "radius") {
+      expectEquals();
+      radiusTok = lex_.peek();
+      radius = nonNegative("radius", true);
+    } else if (a == "name") {
+      obj.name = nameValue().text;
+    } else {
+      return false;
+    }
+    return true;
+  });
+  if (!emission) fail(kw, "sphere_light needs emission = (r, g, b)");
+  if (radius != 1) {
+    obj.transform = obj.transform * Mat4::scale(radius, radius, radius);
+    if (!obj.transform.isFinite()) fail(radiusTok, "sphere_light radius overflows the transform");
+  }
+  obj.kind = ShapeKind::Sphere;
+  checkItemLimit(kw);
+  MaterialDesc m;
+  m.loc = lex_.loc(kw);
+  applyEmission(m, *emission, emissionTok);
+  obj.material = int(scene_.materials.size());
+  scene_.materials.push_back(std::move(m));
   scene_.objects.push_back(std::move(obj));
 }
 
@@ -1065,7 +1204,9 @@ void Parser::checkMeshLimits(const Token& at, uint64_t vertices, uint64_t triang
 //   texture_uv | texcoords | tex_coords = ((u,v), ...);   one per point
 //   materials = ({...} | name, ...);   one per point; each block starts from the default
 //   gennormals; | gennormals = true|false;   compute smooth vertex normals
-//   material = ...; name = ...; }
+//   material = ...; name = ...;
+//   emission = (r,g,b);   COMP4411: radiance Le; the mesh gets a copy of its material with
+//                         emission applied (see applyEmission()) }
 // Each list may be given once; semicolons after lists are optional. Face indices are
 // checked against the point count (when faces come first, at the '}').
 void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
@@ -1086,11 +1227,17 @@ void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
              std::to_string(mesh.points.size()) + " points)");
   };
 
+  std::optional<Color> emission;
+  Token emissionTok;
   block(kw.text, [&](const Token& k) {
     const std::string& a = k.word;
     if (a == "material") {
       expectEquals();
       obj.material = materialValue(defaultMat_);
+    } else if (a == "emission") {
+      expectEquals();
+      emissionTok = k;
+      emission = emissionValue();
     } else if (a == "name") {
       obj.name = nameValue().text;
     } else if (a == "gennormals") {
@@ -1175,6 +1322,7 @@ void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
   perVertex(3, mesh.uvs.size());
   perVertex(4, mesh.vertexMaterials.size());
 
+  if (emission) obj.material = emissiveCopy(obj.material, *emission, emissionTok);
   totalVertices_ += mesh.points.size();
   totalTriangles_ += mesh.triangles.size();
   obj.kind = ShapeKind::Mesh;

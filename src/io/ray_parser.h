@@ -2,6 +2,8 @@
 // every error is an lc::Error carrying file:line:column and what was expected.
 #pragma once
 
+#include <array>
+#include <optional>
 #include <string>
 
 #include "core/limits.h"
@@ -14,6 +16,12 @@ struct ParseOptions {
   // instead of being errors.
   bool lenient = false;
   Limits limits;
+  // `emission = Le` (COMP4411): point lights per unit of world area of the object light it
+  // makes (--emission-density).
+  float emissionDensity = 1;
+  // --default-attenuation A,B,C: the constant, linear and quadratic coefficients of every
+  // point_light and spot_light that sets none of the three (unset: 0, 0, 1).
+  std::optional<std::array<float, 3>> defaultAttenuation;
 };
 
 // Parses a .ray file. Relative paths inside (textures, obj_mesh) resolve against its directory.

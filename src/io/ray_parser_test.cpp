@@ -822,8 +822,8 @@ TEST(RayParserTrimesh, CountMismatchAndMissingLists) {
 }
 
 TEST(RayParserTrimesh, UnknownFieldLenient) {
-  const std::string body = "trimesh { points = ((0,0,0),(1,0,0),(0,1,0)); faces = ((0,1,2));\n  emission = (1,1,1); }";
-  EXPECT_EQ(error(body), "t.ray:3:3: error: unknown keyword 'emission' in trimesh");
+  const std::string body = "trimesh { points = ((0,0,0),(1,0,0),(0,1,0)); faces = ((0,1,2));\n  glow = (1,1,1); }";
+  EXPECT_EQ(error(body), "t.ray:3:3: error: unknown keyword 'glow' in trimesh");
   SceneDesc s = parseLenient(body);
   EXPECT_EQ(s.meshes.size(), 1u);
   EXPECT_EQ(s.warnings.size(), 1u);
@@ -1192,7 +1192,8 @@ TEST(RayParserFiles, DocumentationExampleParses) {
   expectVec(s.objects[2].transform.vector(Vec3(0, 0, 1)), 0, -0.5f, 0, 1e-4f);  // facing down
 }
 
-// Every public scene parses; the one with an unsupported field fails strictly naming it.
+// Every public scene parses strictly, with no warnings (the COMP4411 Cornell box's `emission`
+// included: see RayParserEmission).
 TEST(RayParserPublicScenes, AllParse) {
   namespace fs = std::filesystem;
   int count = 0;
@@ -1201,26 +1202,6 @@ TEST(RayParserPublicScenes, AllParse) {
     ++count;
     const std::string path = entry.path().string();
     const std::string name = entry.path().filename().string();
-    if (name == "COMP4411-Team__Trace__simpleSamples_bonus_cornell_box.ray") {
-      try {
-        parseRayFile(path);
-        ADD_FAILURE() << name << " should fail strictly";
-      } catch (const Error& e) {
-        EXPECT_EQ(e.bare(), "unknown keyword 'emission' in trimesh");
-        EXPECT_EQ(e.loc().line, 17);
-        EXPECT_EQ(e.loc().column, 2);
-        EXPECT_EQ(std::string(e.what()), path + ":17:2: error: unknown keyword 'emission' in trimesh");
-      }
-      ParseOptions o;
-      o.lenient = true;
-      SceneDesc s = parseRayFile(path, o);
-      EXPECT_EQ(s.objects.size(), 6u);
-      ASSERT_EQ(s.warnings.size(), 1u);
-      EXPECT_EQ(s.warnings[0], path + ":17:2: warning: unknown keyword 'emission' in trimesh (skipped)");
-      EXPECT_EQ(s.objects[0].name, "light");
-      expectVec(materialOf(s, 0).diffuse.value, 0.65f, 0.65f, 0.65f);
-      continue;
-    }
     SceneDesc s;
     EXPECT_NO_THROW(s = parseRayFile(path)) << name;
     EXPECT_TRUE(s.warnings.empty()) << name;
@@ -1228,6 +1209,20 @@ TEST(RayParserPublicScenes, AllParse) {
     EXPECT_FALSE(s.objects.empty()) << name;
   }
   EXPECT_GE(count, 13);
+}
+
+TEST(RayParserPublicScenes, CornellBoxEmission) {
+  SceneDesc s = parseRayFile(lc::testing::dataPath("public-scenes/COMP4411-Team__Trace__simpleSamples_bonus_cornell_box.ray"));
+  ASSERT_EQ(s.objects.size(), 6u);
+  EXPECT_EQ(s.objects[0].name, "light");
+  const MaterialDesc& m = materialOf(s, 0);
+  expectVec(m.diffuse.value, 0.65f, 0.65f, 0.65f);
+  expectVec(m.emissive.value, 478.348f, 385.664f, 310.808f);
+  ASSERT_TRUE(m.luminosity);
+  EXPECT_TRUE(m.luminosity->perArea);
+  expectVec(m.luminosity->colour.value, 478.348f, 385.664f, 310.808f);
+  EXPECT_EQ(m.luminosity->loc.line, 17);
+  for (size_t i = 1; i < 6; ++i) EXPECT_FALSE(materialOf(s, i).luminosity) << i;
 }
 
 TEST(RayParserPublicScenes, ConcreteContents) {
@@ -1322,6 +1317,105 @@ TEST(RayParserPublicScenes, ConcreteContents) {
 
   SceneDesc easy = load("OccamsRazer__cs384g__scenes_polymesh_easy3.ray");
   EXPECT_EQ(easy.lights.size(), 3u);
+}
+
+}  // namespace
+}  // namespace lc::io
+
+namespace lc::io {
+namespace {
+
+TEST(RayParserEmission, ObjectMaterialAndSphereLight) {
+  SceneDesc s = parse(
+      "material = { name = grey; diffuse = (0.3, 0.3, 0.3); }\n"
+      "trimesh { material = grey; emission = (1, 2, 3); points = ((0,0,0),(1,0,0),(0,1,0)); faces = ((0,1,2)); }\n"
+      "sphere { emission = (4, 4, 4); material = grey; }\n"
+      "box { material = { emission = (5, 0, 0); diffuse = (0.1, 0.2, 0.3); }; }\n"
+      "translate(1, 2, 3, sphere_light { emission = (7, 8, 9); })\n"
+      "sphere_light { emission = (1, 1, 1); radius = 2; name = bulb; }\n"
+      "sphere { material = grey; }\n",
+      [] {
+        ParseOptions o;
+        o.emissionDensity = 3;
+        return o;
+      }());
+  ASSERT_EQ(s.objects.size(), 6u);
+  // Object-level emission: a copy of the object's material, unnamed, its diffuse kept.
+  const MaterialDesc& t = materialOf(s, 0);
+  EXPECT_EQ(t.name, "");
+  expectVec(t.diffuse.value, 0.3f, 0.3f, 0.3f);
+  expectVec(t.emissive.value, 1, 2, 3);
+  EXPECT_TRUE(t.emissiveSet);
+  ASSERT_TRUE(t.luminosity);
+  EXPECT_TRUE(t.luminosity->perArea);
+  EXPECT_EQ(t.luminosity->intensity, 1);
+  EXPECT_EQ(t.luminosity->density, 3);
+  expectVec(t.luminosity->colour.value, 1, 2, 3);
+  expectVec(materialOf(s, 1).luminosity->colour.value, 4, 4, 4);  // emission before material
+  EXPECT_FALSE(materialOf(s, 5).luminosity);                      // "grey" itself is untouched
+  const MaterialDesc& b = materialOf(s, 2);
+  expectVec(b.diffuse.value, 0.1f, 0.2f, 0.3f);
+  expectVec(b.luminosity->colour.value, 5, 0, 0);
+  // sphere_light: a unit sphere under the transform, black but for its emission.
+  EXPECT_EQ(s.objects[3].kind, ShapeKind::Sphere);
+  expectVec(s.objects[3].transform.point(Vec3(0, 0, 0)), 1, 2, 3);
+  const MaterialDesc& l = materialOf(s, 3);
+  expectVec(l.diffuse.value, 0, 0, 0);
+  expectVec(l.emissive.value, 7, 8, 9);
+  EXPECT_TRUE(l.luminosity && l.luminosity->perArea);
+  EXPECT_EQ(s.objects[4].name, "bulb");
+  expectVec(s.objects[4].transform.vector(Vec3(1, 0, 0)), 2, 0, 0);
+  // emission = (0,0,0) removes a luminosity.
+  SceneDesc z = parse("sphere { material = { luminosity = { intensity = 2; }; emission = (0, 0, 0); }; }");
+  EXPECT_FALSE(materialOf(z, 0).luminosity);
+}
+
+TEST(RayParserEmission, Errors) {
+  EXPECT_EQ(error("sphere { emission = (1, -1, 0); }"),
+            "t.ray:2:21: error: emission components must be finite and >= 0");
+  EXPECT_EQ(error("sphere_light { }"), "t.ray:2:1: error: sphere_light needs emission = (r, g, b)");
+  EXPECT_EQ(error("sphere_light { emission = (1,1,1); radius = 0; }"),
+            "t.ray:2:45: error: radius must be > 0, got 0");
+  EXPECT_EQ(error("sphere_light { emission = (1,1,1); material = { }; }"),
+            "t.ray:2:36: error: unknown keyword 'material' in sphere_light");
+}
+
+TEST(RayParserPbr, AlbedoAndIgnoredKeys) {
+  SceneDesc s = parse(
+      "sphere { material = { type = \"microfacet\"; albedo = (0.2, 0.4, 0.6); metallic = 0.5;\n"
+      "  roughness = 0.3; }; }\n"
+      "sphere { material = { albedo = (0.9, 0.9, 0.9); diffuse = (0.1, 0.1, 0.1); roughness = 0.1;\n"
+      "  translucency = 0.2; type = \"fresnel\"; }; }\n");
+  expectVec(materialOf(s, 0).diffuse.value, 0.2f, 0.4f, 0.6f);
+  expectVec(materialOf(s, 1).diffuse.value, 0.1f, 0.1f, 0.1f);  // diffuse wins over albedo
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0],
+            "t.ray:2:23: warning: PBR material keys ignored (shading is Phong; `albedo` is read as "
+            "diffuse): metallic, roughness (x2), translucency, type (x2)");
+}
+
+TEST(RayParserLights, DefaultAttenuation) {
+  const std::string body =
+      "point_light { position = (0, 0, 1); }\n"
+      "point_light { position = (0, 0, 1); linear_attenuation_coeff = 0.5; }\n"
+      "spot_light { position = (0, 0, 1); direction = (0, 0, -1); }\n"
+      "directional_light { direction = (0, 0, -1); }\n";
+  SceneDesc plain = parse(body);
+  EXPECT_EQ(plain.lights[0].attenConstant, 0);
+  EXPECT_EQ(plain.lights[0].attenQuadratic, 1);
+  ParseOptions o;
+  o.defaultAttenuation = std::array<float, 3>{0.25f, 0.25f, 0.25f};
+  SceneDesc s = parse(body, o);
+  ASSERT_EQ(s.lights.size(), 4u);
+  for (size_t i : {size_t(0), size_t(2)}) {
+    EXPECT_EQ(s.lights[i].attenConstant, 0.25f) << i;
+    EXPECT_EQ(s.lights[i].attenLinear, 0.25f) << i;
+    EXPECT_EQ(s.lights[i].attenQuadratic, 0.25f) << i;
+  }
+  // A light that sets any coefficient keeps the format's defaults for the others.
+  EXPECT_EQ(s.lights[1].attenConstant, 0);
+  EXPECT_EQ(s.lights[1].attenLinear, 0.5f);
+  EXPECT_EQ(s.lights[1].attenQuadratic, 1);
 }
 
 }  // namespace

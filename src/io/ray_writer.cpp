@@ -232,6 +232,7 @@ class Writer {
       if (l.colourFromDiffuse) out_ += in2 + "colour = texture;\n";
       else colour(in2, "colour", l.colour);
       line(in2, "intensity", l.intensity);
+      if (l.perArea) out_ += in2 + "per_area = true;\n";
       line(in2, "density", l.density);
       attenuation(l.attenConstant, l.attenLinear, l.attenQuadratic, in2);
       out_ += in + "};\n";

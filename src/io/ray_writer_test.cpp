@@ -55,6 +55,7 @@ void expectSameMaterial(const MaterialDesc& a, const MaterialDesc& b, const std:
     expectSameColor(x.colour, y.colour, what + " luminosity colour");
     EXPECT_EQ(x.colourFromDiffuse, y.colourFromDiffuse) << what;
     EXPECT_EQ(x.intensity, y.intensity) << what;
+    EXPECT_EQ(x.perArea, y.perArea) << what;
     EXPECT_EQ(x.density, y.density) << what;
     EXPECT_EQ(x.attenConstant, y.attenConstant) << what;
     EXPECT_EQ(x.attenLinear, y.attenLinear) << what;
@@ -191,12 +192,13 @@ transform((0.628056, -0.777996, 0.027880, -0.003280), (0.209187, 0.189095, 1.631
 box { material = { diffuse = map("d.png"); luminosity = { colour = texture; }; }; }
 box { material = { luminosity = { color = map("lum.png"); }; }; }
 area_light { position = (4, 0, -4); u = (-1, 0, 1); v = (-0.5, 1, 0.5); color = (1.0, 0.5, 1.0); }
+translate(0, 5, 0, sphere_light { emission = (3, 2, 1); radius = 0.5; })
 )";
 
 TEST(RayWriter, RoundTripsEveryFeature) {
   SceneDesc s = parseRayString(kEverything, "every.ray", "/scenes", {});
   // Sanity: the source exercises what it claims.
-  ASSERT_EQ(s.objects.size(), 9u);
+  ASSERT_EQ(s.objects.size(), 10u);
   ASSERT_EQ(s.lights.size(), 4u);
   ASSERT_TRUE(s.instantRadiosity);
   roundTrip(s);
@@ -206,9 +208,7 @@ TEST(RayWriter, RoundTripsEveryPublicScene) {
   int count = 0;
   for (const auto& entry : fs::directory_iterator(lc::testing::dataPath("public-scenes"))) {
     if (entry.path().extension() != ".ray") continue;
-    ParseOptions o;
-    o.lenient = true;  // the Cornell box has one unsupported field
-    SceneDesc s = parseRayFile(entry.path().string(), o);
+    SceneDesc s = parseRayFile(entry.path().string());  // strictly: emission is supported
     SCOPED_TRACE(entry.path().filename().string());
     roundTrip(s);
     ++count;

@@ -40,10 +40,14 @@ struct ScalarParam {
 //   intensity  total emitted power of the object (units of point_light colour), default 1
 //   density    point lights per unit of world-space area, default 1
 //   constant/linear/quadratic_attenuation_coeff  default 0, 0, 1
+//   per_area   intensity is per unit of world-space area (default false): the object's total
+//              is intensity x area. `emission = Le` (COMP4411) makes colour = Le, intensity 1,
+//              per_area true: an area A at radiance Le gets total intensity A x Le.
 struct LuminosityDesc {
   ColorParam colour{Color(1, 1, 1), std::nullopt};
   bool colourFromDiffuse = false;  // `colour = texture`: use the material's diffuse map
   float intensity = 1;
+  bool perArea = false;
   float density = 1;
   float attenConstant = 0, attenLinear = 0, attenQuadratic = 1;
   SourceLoc loc;

@@ -26,7 +26,10 @@
 //            (caps included), split over its parts (faces, caps, body) in proportion to
 //            their areas by largest remainder.
 //   Every point of an object with N points has intensity I x colour(uv) / N, so the total
-//   power I x mean colour does not depend on D.
+//   power I x mean colour does not depend on D. With `per_area` (what `emission = Le` makes)
+//   I is per unit of world area: the total is I x A x colour, and a two-sided emitter under
+//   oriented lights gets that on each side (an area A of radiance Le, Lambertian, emits flux
+//   pi A Le per side, and an oriented light of intensity I emits pi I).
 //
 // Kinds:
 //   oriented (default)  LightType::Oriented facing the outward unit normal (world space;
@@ -691,9 +694,13 @@ std::vector<ObjectLightInfo> addObjectLights(scene::Scene& scene, const ObjectLi
     Writer w;
     w.out = set.lights.data() + base;
     w.colour = &l.colour;
-    w.perPoint = float(double(l.intensity) / e.points);
     w.type = oriented ? LightType::Oriented : LightType::Omni;
     w.pair = oriented && e.twoSided;
+    // per_area (emission): intensity x world area, on each side of a two-sided emitter.
+    double power = double(l.intensity) * (l.perArea ? e.area * (w.pair ? 2.0 : 1.0) : 1.0);
+    if (!(power / e.points <= double(std::numeric_limits<float>::max())))
+      throw Error(l.loc, fmt::format("emission x area ({:.3g}) is out of range for a float", power));
+    w.perPoint = float(power / e.points);
     w.group = set.groupFor(g);
     const Shape& sh = scene.shapes()[size_t(e.shape)];
     if (sh.kind == ShapeKind::Mesh) {

@@ -774,6 +774,101 @@ std::string lightcutsBinary() {
   return ec ? "" : (self.parent_path() / "lightcuts").string();
 }
 
+// `emission = Le` (COMP4411) is a per-area luminosity: an area A at radiance Le gets total
+// intensity A x Le (flux pi A Le), on each side of a two-sided emitter; the camera sees Le.
+TEST(ObjectLights, EmissionIsRadianceTimesArea) {
+  Built b = build(
+      // a 2 x 2 panel (object-level emission, as COMP4411's trimesh)
+      "trimesh { material = { diffuse = (0.5, 0.5, 0.5); }; emission = (2, 1, 0.5);"
+      " points = ((-1,-1,0), (1,-1,0), (1,1,0), (-1,1,0)); faces = ((0,1,2), (0,2,3)); }\n"
+      // a sphere_light under scale 2: radius 2, area 16 pi
+      "translate(10, 0, 0, scale(2, sphere_light { emission = (1, 2, 3); }))\n"
+      // emission in a material, on a two-sided square of area 9 (scale 3)
+      "translate(20, 0, 0, scale(3, square { material = { emission = (1, 1, 1); }; }))\n"
+      // sphere_light radius
+      "translate(30, 0, 0, sphere_light { emission = (1, 1, 1); radius = 0.5; })\n");
+  ASSERT_EQ(b.info.size(), 4u);
+  auto near = [](Color got, Color want, double rel) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], rel * std::max(1.0f, want[c])) << c;
+  };
+  near(b.info[0].power, Color(8, 4, 2), 1e-5);
+  EXPECT_NEAR(b.info[0].area, 4, 1e-6);
+  const double sphere = 16 * kPiD;
+  near(b.info[1].power, Color(float(sphere), float(2 * sphere), float(3 * sphere)), 1e-5);
+  near(b.info[2].power, Color(18, 18, 18), 1e-5);  // 9 on each side
+  near(b.info[3].power, Color(float(kPiD), float(kPiD), float(kPiD)), 1e-5);
+  // Density: --emission-density (ParseOptions::emissionDensity) lights per unit area.
+  EXPECT_EQ(b.info[0].lights, 4u);
+  io::ParseOptions po;
+  po.emissionDensity = 25;
+  Built dense = buildDesc(io::parseRayString(
+      "SBT-raytracer 1.0\ntrimesh { emission = (2, 1, 0.5);"
+      " points = ((-1,-1,0), (1,-1,0), (1,1,0), (-1,1,0)); faces = ((0,1,2), (0,2,3)); }\n",
+      "t.ray", "/base", po));
+  ASSERT_EQ(dense.info.size(), 1u);
+  EXPECT_EQ(dense.info[0].lights, 100u);
+  near(dense.info[0].power, Color(8, 4, 2), 1e-5);
+  // The camera sees the emitters at Le.
+  scene::Hit h;
+  ASSERT_TRUE(b.scene->intersect(scene::Ray{Vec3(0.3f, 0.2f, 5), Vec3(0, 0, -1)}, h));
+  near(b.scene->shadingMaterial(h).ke, Color(2, 1, 0.5f), 1e-6);
+  ASSERT_TRUE(b.scene->intersect(scene::Ray{Vec3(10, 0, 5), Vec3(0, 0, -1)}, h));
+  near(b.scene->shadingMaterial(h).ke, Color(1, 2, 3), 1e-6);
+  EXPECT_NEAR(h.p.z, 2, 1e-3);
+  // The panel keeps its own material's diffuse.
+  ASSERT_TRUE(b.scene->intersect(scene::Ray{Vec3(0.3f, 0.2f, 5), Vec3(0, 0, -1)}, h));
+  near(b.scene->shadingMaterial(h).kd, Color(0.5f, 0.5f, 0.5f), 1e-6);
+}
+
+// Closed form: a square emitter of half-side a and radiance Le, facing down at height h over
+// a diffuse plane (kd). The renderer's diffuse term is kd cos(theta_s) x I cos(theta_l) / d^2
+// per oriented light (no 1/pi; point_light colour units), and the lights sum to A Le, so the
+// plane below the centre shows kd Le times the integral of cos cos / d^2 over the square:
+//   kd Le 4 X / sqrt(1 + X^2) atan(X / sqrt(1 + X^2)),   X = a / h   (-> kd Le A / h^2).
+// Checked in process (every light) and through the CLI's brute-force render.
+TEST(ObjectLights, EmittingSquareOverAPlaneMatchesTheClosedForm) {
+  const double a = 0.5, hgt = 2, kd = 0.5, le = 3;
+  const double X = a / hgt, r = std::sqrt(1 + X * X);
+  const double want = kd * le * 4 * X / r * std::atan(X / r);
+  EXPECT_NEAR(want, kd * le * 4 * a * a / (hgt * hgt), 0.1 * want);  // small-source limit (8% here)
+  const std::string body =
+      "camera { position = (0, -4, 1); look_at = (0, 0, 0); fov = 10; }\n"
+      "trimesh { material = { diffuse = (0.5, 0.5, 0.5); };"
+      " points = ((-10,-10,0), (10,-10,0), (10,10,0), (-10,10,0)); faces = ((0,1,2), (0,2,3)); }\n"
+      "trimesh { emission = (3, 3, 3);"
+      " points = ((-0.5,-0.5,2), (0.5,-0.5,2), (0.5,0.5,2), (-0.5,0.5,2)); faces = ((0,2,1), (0,3,2)); }\n";
+  io::ParseOptions po;
+  po.emissionDensity = 400;  // 400 lights on the unit square
+  Built b = buildDesc(io::parseRayString("SBT-raytracer 1.0\n" + body, "t.ray", "/base", po));
+  ASSERT_EQ(b.info.size(), 1u);
+  EXPECT_EQ(b.info[0].lights, 400u);
+  double sum = 0;
+  const LightSet& set = b.scene->lights();
+  for (const Light& l : set.lights) {
+    Vec3 d = l.position;  // from the origin
+    float dist = length(d);
+    Vec3 wi = d / dist;
+    sum += kd * l.intensity.y * set.groups[l.group].atten(dist) * std::max(0.0f, -dot(l.direction, wi)) *
+           std::max(0.0f, wi.z);
+  }
+  EXPECT_NEAR(sum, want, 0.005 * want);
+
+  std::string bin = lightcutsBinary();
+  ASSERT_TRUE(std::filesystem::exists(bin)) << "build the lightcuts target (" << bin << ")";
+  testing::TempDir dir;
+  std::string scene = dir.file("square.ray"), out = dir.file("square.exr");
+  std::ofstream(scene) << "SBT-raytracer 1.0\n" << body;
+  std::string cmd = "'" + bin + "' render '" + scene + "' -o '" + out +
+                    "' --width 33 --height 33 --method brute --emission-density 400 --threads 2 -q > '" +
+                    dir.file("log.txt") + "' 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  io::Image img = io::readImage(out);
+  ASSERT_EQ(img.width, 33);
+  Color c = img.at(16, 16);  // the pixel through look_at: the plane right below the emitter
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], want, 0.01 * want) << k;
+  std::printf("closed form %.5f, lights %.5f, brute render %.5f\n", want, sum, double(c.y));
+}
+
 // The Cornell box lit by its ceiling panel: the floor below the panel is lit, and brighter
 // than the floor's corners; in-process (every light, shadow rays) and through the renderer
 // (the CLI, brute force at 64x64).

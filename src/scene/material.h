@@ -29,6 +29,7 @@ struct TexScalar {
 struct Luminosity {
   TexColor colour;  // per-light colour, sampled at each light's uv
   float intensity = 1;
+  bool perArea = false;  // intensity per unit of world area (io::LuminosityDesc::perArea)
   float density = 1;
   float attenConstant = 0, attenLinear = 0, attenQuadratic = 1;
   SourceLoc loc;

@@ -143,6 +143,7 @@ std::unique_ptr<Scene> Scene::build(const io::SceneDesc& desc, const BuildOption
       Luminosity l;
       l.colour = ld.colourFromDiffuse ? m.diffuse : resolveColor(ld.colour, cache, options);
       l.intensity = ld.intensity;
+      l.perArea = ld.perArea;
       l.density = ld.density;
       l.attenConstant = ld.attenConstant;
       l.attenLinear = ld.attenLinear;
