@@ -772,7 +772,7 @@ void interruptTest(int sig) {
   ASSERT_TRUE(c.wait(30));
   double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   EXPECT_EQ(c.termSignal(), 0);
-  EXPECT_EQ(c.status(), 130) << c.stderrText();
+  EXPECT_EQ(c.status(), 128 + sig) << c.stderrText();  // 130 for SIGINT, 143 for SIGTERM
   EXPECT_LT(seconds, 2.0) << "took " << seconds << " s to stop";
   EXPECT_EQ(slurp(dir.file("out.png")), old);
   EXPECT_TRUE(fs::exists(dir.file("out.png.partial.exr")));
@@ -786,6 +786,54 @@ void interruptTest(int sig) {
 
 TEST(CliInterrupt, SigintKeepsTheOldOutputAndWritesThePartialImage) { interruptTest(SIGINT); }
 TEST(CliInterrupt, SigtermKeepsTheOldOutputAndWritesThePartialImage) { interruptTest(SIGTERM); }
+
+// Issue 23: the flag was checked only between 16 x 16 tiles, so an image of one tile ran to
+// the end (exit 0, the old output replaced). It is checked at every pixel now.
+TEST(CliInterrupt, SigtermStopsInsideASingleTile) {
+  TempDir dir;
+  writeText(dir.file("slow.ray"), slowScene());
+  const std::string old = "previous image";
+  writeText(dir.file("out.png"), old);
+  // 16 x 16 pixels, 4096 samples of 600 lights each: minutes on one thread.
+  Child c({"render", "slow.ray", "-o", "out.png", "--method", "brute", "--width", "16", "--height", "16", "--spp",
+           "4096", "--threads", "2"},
+          dir.path());
+  ASSERT_TRUE(c.waitForStderr("rendering", 120)) << c.stderrText();
+  auto t0 = Clock::now();
+  c.signal(SIGTERM);
+  ASSERT_TRUE(c.wait(30));
+  double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_EQ(c.termSignal(), 0);
+  EXPECT_EQ(c.status(), 143) << c.stderrText();
+  EXPECT_LT(seconds, 2.0) << "took " << seconds << " s to stop";
+  EXPECT_EQ(slurp(dir.file("out.png")), old);
+  EXPECT_TRUE(fs::exists(dir.file("out.png.partial.exr")));
+  EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"slow.ray", "out.png", "out.png.partial.exr"}));
+}
+
+// Issue 23: shooting VPLs ignored the signals' flag (the handlers were set only for the
+// render); it is checked per block of paths, and the run exits as an interrupted render.
+TEST(CliInterrupt, SigtermStopsVplShooting) {
+  TempDir dir;
+  writeText(dir.file("room.ray"), kHeader + "camera { position = (0,0,0); viewdir = (0,0,-1); }\n"
+                                            "point_light { position = (0,0,0); colour = (1,1,1); }\n"
+                                            "scale(10, sphere { material = { diffuse = (0.8,0.8,0.8); }; })\n");
+  writeText(dir.file("out.png"), "old");
+  Child c({"render", "room.ray", "-o", "out.png", "--width", "8", "--vpls", "40000000", "--bounces", "4",
+           "--max-vpls", "100000000", "--threads", "2"},
+          dir.path());
+  ASSERT_TRUE(c.waitForStderr("VPLs", 120)) << c.stderrText();
+  auto t0 = Clock::now();
+  c.signal(SIGTERM);
+  ASSERT_TRUE(c.wait(30));
+  double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_EQ(c.termSignal(), 0);
+  EXPECT_EQ(c.status(), 143) << c.stderrText();
+  EXPECT_LT(seconds, 2.0) << "took " << seconds << " s to stop";
+  EXPECT_NE(c.stderrText().find("lightcuts: interrupted; out.png untouched"), std::string::npos) << c.stderrText();
+  EXPECT_EQ(slurp(dir.file("out.png")), "old");
+  EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"room.ray", "out.png"}));
+}
 
 // An unwritable output fails at once, before the (long) render, and writes nothing.
 TEST(CliInterrupt, UnwritableOutputFailsBeforeRendering) {
