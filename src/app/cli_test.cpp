@@ -862,6 +862,56 @@ TEST(CliInterrupt, ReadOnlyDirectory) {
   EXPECT_TRUE(fs::is_empty(dir.file("ro")));
 }
 
+// Issue 23: outputs were written to a temporary file renamed over the path, whatever sat
+// there. `--stats /dev/null` (as root) turned /dev/null into a JSON file.
+TEST(CliOutputTarget, DeviceNodeIsWrittenNotReplaced) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + "sphere {}");
+  CliResult r = run({"render", "s.ray", "-o", "out.png", "--width", "8", "-q", "--stats", "/dev/null"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  struct stat st;
+  ASSERT_EQ(stat("/dev/null", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode)) << "/dev/null is no longer a character device";
+  EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"s.ray", "out.png"}));
+}
+
+// A symlink is followed: its target gets the image, the link stays a link.
+TEST(CliOutputTarget, SymlinkTargetIsWritten) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + "sphere {}");
+  fs::create_directory(dir.file("real"));
+  writeText(dir.file("real/out.png"), "old");
+  fs::create_symlink("real/out.png", dir.file("link.png"));
+  fs::create_symlink("real/new.png", dir.file("dangling.png"));
+  CliResult r = run({"render", "s.ray", "-o", "link.png", "--width", "8", "-q"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(dir.file("link.png")));
+  EXPECT_EQ(slurp(dir.file("real/out.png")).substr(1, 3), "PNG");
+  r = run({"render", "s.ray", "-o", "dangling.png", "--width", "8", "-q"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(dir.file("dangling.png")));
+  EXPECT_EQ(slurp(dir.file("real/new.png")).substr(1, 3), "PNG");
+  EXPECT_EQ(filesIn(dir.file("real")), (std::set<std::string>{"out.png", "new.png"}));
+}
+
+// A read-only file (0444) in a writable folder is refused, before the render, even for root.
+TEST(CliOutputTarget, ReadOnlyFileIsRefused) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + "sphere {}");
+  writeText(dir.file("out.png"), "old");
+  chmod(dir.file("out.png").c_str(), 0444);
+  CliResult r = run({"render", "s.ray", "-o", "out.png", "--width", "8", "-q"}, dir.path());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, "lightcuts: cannot write 'out.png': it is read-only\n");
+  EXPECT_EQ(slurp(dir.file("out.png")), "old");
+  writeText(dir.file("stats.json"), "{}");
+  chmod(dir.file("stats.json").c_str(), 0444);
+  r = run({"render", "s.ray", "-o", "new.png", "--width", "8", "-q", "--stats", "stats.json"}, dir.path());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, "lightcuts: cannot write 'stats.json': it is read-only\n");
+  EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"s.ray", "out.png", "stats.json"}));
+}
+
 // A failed render (bad input) leaves an existing output as it was.
 TEST(CliInterrupt, ErrorKeepsTheOldOutput) {
   TempDir dir;
