@@ -299,6 +299,14 @@ std::vector<Row> catalogue() {
   // Rows that need more than one .ray body.
   rows[1].message = "missing_header.ray:1:1: error: expected the header 'SBT-raytracer 1.0', got end of file";
   rows[1].files = {{"missing_header.ray", ""}};
+  {
+    // Issue 23: one huge polygon (tinyobj's triangulation is quadratic in its size).
+    std::string body = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
+    for (int i = 0; i < 4097; ++i) body += " " + std::to_string(i % 3 + 1);
+    rows.push_back(objRow("obj_huge_polygon", body + "\n",
+                          "obj_huge_polygon.obj:4: error: face has 4097 vertices, more than 4096 in one polygon "
+                          "(split it into smaller faces)"));
+  }
 
   {
     Row r;
