@@ -345,6 +345,15 @@ std::vector<Row> catalogue() {
     rows.push_back(r);
   }
   {
+    // Issue 23: a truncated image read as valid (RMSE 0 from uninitialised memory).
+    Row r;
+    r.name = "truncated_image";
+    r.files = {{"a.ppm", "P6\n2 1\n255\nabcdef"}, {"trunc.ppm", "P6\n2 1\n255\nabc"}};
+    r.args = {"compare", "a.ppm", "trunc.ppm"};
+    r.message = "cannot read image 'trunc.ppm': truncated PNM data: 3 bytes of samples, the header needs 6";
+    rows.push_back(r);
+  }
+  {
     Row r;
     r.name = "image_size_mismatch";
     r.files = {{"a.ppm", "P6\n2 1\n255\nabcdef"}, {"b.ppm", "P6\n1 1\n255\nabc"}};
