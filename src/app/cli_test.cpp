@@ -299,6 +299,14 @@ std::vector<Row> catalogue() {
   // Rows that need more than one .ray body.
   rows[1].message = "missing_header.ray:1:1: error: expected the header 'SBT-raytracer 1.0', got end of file";
   rows[1].files = {{"missing_header.ray", ""}};
+  {
+    // Issue 23: one huge polygon (tinyobj's triangulation is quadratic in its size).
+    std::string body = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
+    for (int i = 0; i < 4097; ++i) body += " " + std::to_string(i % 3 + 1);
+    rows.push_back(objRow("obj_huge_polygon", body + "\n",
+                          "obj_huge_polygon.obj:4: error: face has 4097 vertices, more than 4096 in one polygon "
+                          "(split it into smaller faces)"));
+  }
 
   {
     Row r;
@@ -334,6 +342,15 @@ std::vector<Row> catalogue() {
     r.files = {{"junk.png", "@junk"}, {"b.ppm", "P6\n1 1\n255\nabc"}};
     r.args = {"compare", "junk.png", "b.ppm"};
     r.message = "cannot read image 'junk.png': unknown image type";
+    rows.push_back(r);
+  }
+  {
+    // Issue 23: a truncated image read as valid (RMSE 0 from uninitialised memory).
+    Row r;
+    r.name = "truncated_image";
+    r.files = {{"a.ppm", "P6\n2 1\n255\nabcdef"}, {"trunc.ppm", "P6\n2 1\n255\nabc"}};
+    r.args = {"compare", "a.ppm", "trunc.ppm"};
+    r.message = "cannot read image 'trunc.ppm': truncated PNM data: 3 bytes of samples, the header needs 6";
     rows.push_back(r);
   }
   {
@@ -772,7 +789,7 @@ void interruptTest(int sig) {
   ASSERT_TRUE(c.wait(30));
   double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   EXPECT_EQ(c.termSignal(), 0);
-  EXPECT_EQ(c.status(), 130) << c.stderrText();
+  EXPECT_EQ(c.status(), 128 + sig) << c.stderrText();  // 130 for SIGINT, 143 for SIGTERM
   EXPECT_LT(seconds, 2.0) << "took " << seconds << " s to stop";
   EXPECT_EQ(slurp(dir.file("out.png")), old);
   EXPECT_TRUE(fs::exists(dir.file("out.png.partial.exr")));
@@ -786,6 +803,54 @@ void interruptTest(int sig) {
 
 TEST(CliInterrupt, SigintKeepsTheOldOutputAndWritesThePartialImage) { interruptTest(SIGINT); }
 TEST(CliInterrupt, SigtermKeepsTheOldOutputAndWritesThePartialImage) { interruptTest(SIGTERM); }
+
+// Issue 23: the flag was checked only between 16 x 16 tiles, so an image of one tile ran to
+// the end (exit 0, the old output replaced). It is checked at every pixel now.
+TEST(CliInterrupt, SigtermStopsInsideASingleTile) {
+  TempDir dir;
+  writeText(dir.file("slow.ray"), slowScene());
+  const std::string old = "previous image";
+  writeText(dir.file("out.png"), old);
+  // 16 x 16 pixels, 4096 samples of 600 lights each: minutes on one thread.
+  Child c({"render", "slow.ray", "-o", "out.png", "--method", "brute", "--width", "16", "--height", "16", "--spp",
+           "4096", "--threads", "2"},
+          dir.path());
+  ASSERT_TRUE(c.waitForStderr("rendering", 120)) << c.stderrText();
+  auto t0 = Clock::now();
+  c.signal(SIGTERM);
+  ASSERT_TRUE(c.wait(30));
+  double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_EQ(c.termSignal(), 0);
+  EXPECT_EQ(c.status(), 143) << c.stderrText();
+  EXPECT_LT(seconds, 2.0) << "took " << seconds << " s to stop";
+  EXPECT_EQ(slurp(dir.file("out.png")), old);
+  EXPECT_TRUE(fs::exists(dir.file("out.png.partial.exr")));
+  EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"slow.ray", "out.png", "out.png.partial.exr"}));
+}
+
+// Issue 23: shooting VPLs ignored the signals' flag (the handlers were set only for the
+// render); it is checked per block of paths, and the run exits as an interrupted render.
+TEST(CliInterrupt, SigtermStopsVplShooting) {
+  TempDir dir;
+  writeText(dir.file("room.ray"), kHeader + "camera { position = (0,0,0); viewdir = (0,0,-1); }\n"
+                                            "point_light { position = (0,0,0); colour = (1,1,1); }\n"
+                                            "scale(10, sphere { material = { diffuse = (0.8,0.8,0.8); }; })\n");
+  writeText(dir.file("out.png"), "old");
+  Child c({"render", "room.ray", "-o", "out.png", "--width", "8", "--vpls", "40000000", "--bounces", "4",
+           "--max-vpls", "100000000", "--threads", "2"},
+          dir.path());
+  ASSERT_TRUE(c.waitForStderr("VPLs", 120)) << c.stderrText();
+  auto t0 = Clock::now();
+  c.signal(SIGTERM);
+  ASSERT_TRUE(c.wait(30));
+  double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  EXPECT_EQ(c.termSignal(), 0);
+  EXPECT_EQ(c.status(), 143) << c.stderrText();
+  EXPECT_LT(seconds, 2.0) << "took " << seconds << " s to stop";
+  EXPECT_NE(c.stderrText().find("lightcuts: interrupted; out.png untouched"), std::string::npos) << c.stderrText();
+  EXPECT_EQ(slurp(dir.file("out.png")), "old");
+  EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"room.ray", "out.png"}));
+}
 
 // An unwritable output fails at once, before the (long) render, and writes nothing.
 TEST(CliInterrupt, UnwritableOutputFailsBeforeRendering) {
@@ -812,6 +877,56 @@ TEST(CliInterrupt, ReadOnlyDirectory) {
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(r.err, "lightcuts: cannot write 'ro/out.png': Permission denied\n");
   EXPECT_TRUE(fs::is_empty(dir.file("ro")));
+}
+
+// Issue 23: outputs were written to a temporary file renamed over the path, whatever sat
+// there. `--stats /dev/null` (as root) turned /dev/null into a JSON file.
+TEST(CliOutputTarget, DeviceNodeIsWrittenNotReplaced) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + "sphere {}");
+  CliResult r = run({"render", "s.ray", "-o", "out.png", "--width", "8", "-q", "--stats", "/dev/null"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  struct stat st;
+  ASSERT_EQ(stat("/dev/null", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode)) << "/dev/null is no longer a character device";
+  EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"s.ray", "out.png"}));
+}
+
+// A symlink is followed: its target gets the image, the link stays a link.
+TEST(CliOutputTarget, SymlinkTargetIsWritten) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + "sphere {}");
+  fs::create_directory(dir.file("real"));
+  writeText(dir.file("real/out.png"), "old");
+  fs::create_symlink("real/out.png", dir.file("link.png"));
+  fs::create_symlink("real/new.png", dir.file("dangling.png"));
+  CliResult r = run({"render", "s.ray", "-o", "link.png", "--width", "8", "-q"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(dir.file("link.png")));
+  EXPECT_EQ(slurp(dir.file("real/out.png")).substr(1, 3), "PNG");
+  r = run({"render", "s.ray", "-o", "dangling.png", "--width", "8", "-q"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::is_symlink(dir.file("dangling.png")));
+  EXPECT_EQ(slurp(dir.file("real/new.png")).substr(1, 3), "PNG");
+  EXPECT_EQ(filesIn(dir.file("real")), (std::set<std::string>{"out.png", "new.png"}));
+}
+
+// A read-only file (0444) in a writable folder is refused, before the render, even for root.
+TEST(CliOutputTarget, ReadOnlyFileIsRefused) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + "sphere {}");
+  writeText(dir.file("out.png"), "old");
+  chmod(dir.file("out.png").c_str(), 0444);
+  CliResult r = run({"render", "s.ray", "-o", "out.png", "--width", "8", "-q"}, dir.path());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, "lightcuts: cannot write 'out.png': it is read-only\n");
+  EXPECT_EQ(slurp(dir.file("out.png")), "old");
+  writeText(dir.file("stats.json"), "{}");
+  chmod(dir.file("stats.json").c_str(), 0444);
+  r = run({"render", "s.ray", "-o", "new.png", "--width", "8", "-q", "--stats", "stats.json"}, dir.path());
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, "lightcuts: cannot write 'stats.json': it is read-only\n");
+  EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"s.ray", "out.png", "stats.json"}));
 }
 
 // A failed render (bad input) leaves an existing output as it was.

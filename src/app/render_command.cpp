@@ -5,10 +5,12 @@
 #include <cmath>
 #include <csignal>
 #include <filesystem>
+#include <optional>
 #include <thread>
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/interrupt.h"
 #include "app/progress.h"
 #include "app/scene_loader.h"
 #include "app/scene_options.h"
@@ -25,8 +27,6 @@ namespace {
 
 constexpr int kMaxImageSide = 1 << 16;  // --width, --height and sizes from the aspect ratio
 
-std::atomic<bool> gInterrupted{false};
-extern "C" void onSignal(int) { gInterrupted.store(true); }
 
 struct RenderArgs {
   std::string scene;
@@ -124,7 +124,15 @@ int runRender(RenderArgs& a) {
   // sRGB texture maps (from MTL files) are linearised only for a physically based output.
   a.load.linearizeSrgbTextures = tonemap == io::ToneMap::Srgb;
   a.load.quiet = a.quiet;
-  LoadedScene ls = loadScene(a.scene, a.load);
+  a.load.interruptible = true;
+  LoadedScene ls;
+  try {
+    ls = loadScene(a.scene, a.load);
+  } catch (const Interrupted&) {
+    // Stopped while making the lights: nothing rendered, nothing written.
+    fmt::print(stderr, "lightcuts: interrupted; {} untouched\n", a.out);
+    return interruptExitStatus();
+  }
   scene::Scene& scene = *ls.scene;
   for (const std::string& w : ls.warnings) fmt::print(stderr, "warning: {}\n", w);
   if (!ls.objDescription.empty() && !a.quiet)
@@ -179,25 +187,23 @@ int runRender(RenderArgs& a) {
   ro.referencePixels = a.referencePixels;
   ro.reconstructSpacing = method == lightcuts::Method::Lightcuts ? reconstructSpacing(a.reconstruct, a.width, a.height) : 0;
   ro.reconstructCoarseSpacing = reconstructCoarseSpacing(a.reconstructCoarse, ro.reconstructSpacing);
-  ro.cancel = &gInterrupted;
+  ro.cancel = &interruptFlag();
   ProgressBar bar("rendering", a.quiet);
   ro.progress = [&](double f) { bar.update(f); };
   ProgressBar refBar("reference pixels", a.quiet);
   ro.referenceProgress = [&](double f) { refBar.update(f); };
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  std::optional<InterruptScope> interrupts(std::in_place);
   render::RenderResult rr = render::render(scene, *evaluator, ro);
   bar.finish();
   refBar.finish();
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  interrupts.reset();
 
-  if (rr.interrupted) {
+  if (rr.interrupted || interruptFlag().load()) {
     // Leave the requested output alone; keep what was rendered in OUT.partial.exr.
     std::string partial = a.out + ".partial.exr";
     io::writeImage(partial, rr.image);
     fmt::print(stderr, "lightcuts: interrupted; {} untouched, partial image in {}\n", a.out, partial);
-    return 130;
+    return interruptExitStatus();
   }
 
   io::writeImage(a.out, rr.image, tonemap);

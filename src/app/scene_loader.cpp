@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "app/interrupt.h"
 #include "app/progress.h"
 #include "core/file_util.h"
 #include "io/obj_loader.h"
@@ -40,8 +41,11 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
   out.accelSeconds = since(t1);
 
   auto t2 = Clock::now();
+  std::optional<InterruptScope> interrupts;
+  if (o.interruptible) interrupts.emplace();
   lights::ObjectLightOptions olo = o.objectLights;
   olo.maxLights = o.limits.maxLights;
+  if (o.interruptible) olo.cancel = &interruptFlag();
   {
     ProgressBar bar("object lights", o.quiet);
     olo.progress = [&](double f) { bar.update(f); };
@@ -64,6 +68,7 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
     if (o.vplClamp) v.clamp = *o.vplClamp;
     if (o.vplSeed) v.seed = *o.vplSeed;
     v.maxVpls = o.limits.maxVpls;
+    if (o.interruptible) v.cancel = &interruptFlag();
     if (v.count > 0) {
       ProgressBar bar("VPLs", o.quiet);
       v.progress = [&](double f) { bar.update(f); };
@@ -71,6 +76,9 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
       bar.finish();
     }
   }
+  // A signal caught after the last check: stop here, not after the next phase.
+  if (o.interruptible && interruptFlag().load()) throw Interrupted();
+  interrupts.reset();
   if (out.scene->lights().size() > o.limits.maxLights)
     throw Error("the scene has " + std::to_string(out.scene->lights().size()) +
                 " lights, more than --max-lights (" + std::to_string(o.limits.maxLights) + ")");

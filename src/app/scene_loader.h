@@ -34,6 +34,9 @@ struct LoadOptions {
   // Linearise sRGB-marked (MTL) textures: scene::BuildOptions::linearizeSrgbTextures.
   bool linearizeSrgbTextures = false;
   bool quiet = false;
+  // SIGINT/SIGTERM stop the object lights and VPLs (app/interrupt.h): loadScene then throws
+  // lc::Interrupted. Off, the signals keep their default effect.
+  bool interruptible = false;
 };
 
 struct LoadedScene {

@@ -1,6 +1,7 @@
 #include "core/file_util.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -33,9 +34,55 @@ static std::string tempNameFor(const std::string& path) {
   return path + ".tmp-" + std::to_string(getpid()) + "-" + std::to_string(counter++);
 }
 
+namespace {
+
+// Where an output to `path` goes. A symlink is followed to the file it names (the link
+// stays a link); a character device, FIFO or socket (/dev/null, /dev/stdout) is written in place,
+// since renaming over it would replace the node; anything else that exists must be a
+// writable regular file.
+struct OutputTarget {
+  std::string path;     // the file to replace (or write directly)
+  bool direct = false;  // a device, FIFO or socket: write to it, no temporary, no rename
+};
+
+OutputTarget outputTarget(const std::string& path) {
+  OutputTarget t{path, false};
+  // Checked through any links first: /dev/stdout links to /proc/self/fd/1, whose own link
+  // text ("pipe:[123]") is no path.
+  struct stat st;
+  if (::stat(path.c_str(), &st) == 0 && (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode) || S_ISSOCK(st.st_mode))) {
+    t.direct = true;
+    return t;
+  }
+  fs::path p(path);
+  for (int hops = 0;; ++hops) {
+    struct stat ls;
+    if (::lstat(p.c_str(), &ls) != 0 || !S_ISLNK(ls.st_mode)) break;
+    if (hops >= 40) throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(ELOOP));
+    fs::path link = fs::read_symlink(p);
+    p = link.is_absolute() ? link : p.parent_path() / link;
+  }
+  t.path = p.lexically_normal().string();
+  if (::stat(t.path.c_str(), &st) != 0) return t;  // a new file
+  if (S_ISDIR(st.st_mode)) throw Error("cannot write " + quoteInput(path) + ": it is a directory");
+  if (!S_ISREG(st.st_mode))
+    throw Error("cannot write " + quoteInput(path) + ": it is not a regular file, a character device or a FIFO");
+  // Root may write anything, so the mode bits decide as well as access().
+  if ((st.st_mode & 0222) == 0 || (::access(t.path.c_str(), W_OK) != 0 && (errno == EACCES || errno == EROFS)))
+    throw Error("cannot write " + quoteInput(path) + ": it is read-only");
+  return t;
+}
+
+}  // namespace
+
 void writeFileAtomically(const std::string& path,
                          const std::function<void(const std::string&)>& write) {
-  std::string tmp = tempNameFor(path);
+  const OutputTarget target = outputTarget(path);
+  if (target.direct) {
+    write(target.path);
+    return;
+  }
+  std::string tmp = tempNameFor(target.path);
   try {
     write(tmp);
     // Flush to disk before the rename so a crash cannot leave an empty file behind.
@@ -45,7 +92,7 @@ void writeFileAtomically(const std::string& path,
     ::close(fd);
     if (syncErr != 0 && syncErr != EINVAL)
       throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(syncErr));
-    if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    if (std::rename(tmp.c_str(), target.path.c_str()) != 0)
       throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(errno));
   } catch (...) {
     std::remove(tmp.c_str());
@@ -86,7 +133,15 @@ void checkWritable(const std::string& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec))
     throw Error("cannot write " + quoteInput(path) + ": it is a directory");
-  std::string tmp = tempNameFor(path);
+  const OutputTarget target = outputTarget(path);
+  if (target.direct) {
+    int fd = ::open(target.path.c_str(), O_WRONLY | O_NONBLOCK);
+    // A FIFO with no reader yet (ENXIO) is fine: the write opens it later and waits.
+    if (fd < 0 && errno != ENXIO) throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(errno));
+    if (fd >= 0) ::close(fd);
+    return;
+  }
+  std::string tmp = tempNameFor(target.path);
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
   if (fd < 0) throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(errno));
   ::close(fd);

@@ -12,12 +12,17 @@ std::string readFile(const std::string& path);
 
 // Writes `path` atomically: `write` fills a temporary file in the same directory,
 // which is then renamed over `path`. On any failure the temporary is removed, the old
-// file (if any) is untouched, and lc::Error is thrown.
+// file (if any) is untouched, and lc::Error is thrown. A symlink is followed: its target
+// is replaced, the link kept. A character device or FIFO (/dev/null, /dev/stdout) is
+// written directly (`write` gets `path` itself), never replaced. Any other existing
+// non-regular file, and a read-only file (no write permission bits, or not writable by
+// this user), is refused: "cannot write 'p': it is read-only".
 void writeFileAtomically(const std::string& path,
                          const std::function<void(const std::string& tmpPath)>& write);
 
 // Throws lc::Error when a file could not be created at `path` (missing or unwritable
-// directory), so a long render fails before it starts rather than after.
+// directory) or writeFileAtomically would refuse it (read-only, not a regular file), so a
+// long render fails before it starts rather than after.
 void checkWritable(const std::string& path);
 
 // A file the command reads or writes, with what it is ("the output image (-o)").

@@ -432,7 +432,17 @@ bool readPnm16(const std::string& path, const std::vector<uint8_t>& b, bool srgb
   };
   uint64_t w = 0, h = 0, maxval = 0;
   if (!number(w) || !number(h) || !number(maxval)) return false;
-  if (maxval <= 255) return false;  // 8-bit: stb reads those correctly
+  if (maxval <= 255) {
+    // 8-bit: stb decodes those, but reads missing samples as whatever its buffer held
+    // (issue 23: a 32x32 P6 header and 100 bytes compared equal to anything dark).
+    if (p < b.size() && isSpace(b[p]) && w > 0 && h > 0 && w <= uint64_t(1) << 24 && h <= uint64_t(1) << 24) {
+      const uint64_t need = w * h * (b[1] == '5' ? 1 : 3);
+      if (b.size() - (p + 1) < need)
+        throwDecode(path, "truncated PNM data: " + std::to_string(b.size() - (p + 1)) + " bytes of samples, the header needs " +
+                              std::to_string(need));
+    }
+    return false;
+  }
   if (p >= b.size() || !isSpace(b[p])) throwDecode(path, "bad PNM header");
   ++p;  // exactly one whitespace character before the samples
   if (maxval > 65535) throwDecode(path, "PNM maxval " + std::to_string(maxval) + " is more than 65535");
@@ -450,6 +460,62 @@ bool readPnm16(const std::string& path, const std::vector<uint8_t>& b, bool srgb
       out.pixels[i][int(c)] = srgb ? srgbToLinear(v) : v;
     }
   return true;
+}
+
+uint32_t le16(const std::vector<uint8_t>& b, size_t i) { return uint32_t(b[i]) | uint32_t(b[i + 1]) << 8; }
+uint32_t le32(const std::vector<uint8_t>& b, size_t i) { return le16(b, i) | le16(b, i + 2) << 16; }
+
+// stb_image reads past the end of a BMP or TGA as zeros (or what its buffer held), so a
+// truncated file decoded as a valid image (issue 23). The data length is checked against
+// the header first: "" when it is long enough (or the format is not one checked here).
+std::string bmpTgaTruncation(const std::vector<uint8_t>& b) {
+  auto message = [](uint64_t have, uint64_t need, const char* what) {
+    return std::string("truncated ") + what + " data: the file has " + std::to_string(have) +
+           " bytes, the header needs " + std::to_string(need);
+  };
+  if (b.size() >= 2 && b[0] == 'B' && b[1] == 'M') {
+    if (b.size() < 26) return "truncated BMP header";
+    const uint64_t offset = le32(b, 10), dib = le32(b, 14);
+    uint64_t w = 0, h = 0, bpp = 0, compression = 0;
+    if (dib == 12) {
+      w = le16(b, 18);
+      h = le16(b, 20);
+      bpp = b.size() >= 26 ? le16(b, 24) : 0;
+    } else {
+      if (b.size() < 34) return "truncated BMP header";
+      w = uint64_t(std::abs(int64_t(int32_t(le32(b, 18)))));
+      h = uint64_t(std::abs(int64_t(int32_t(le32(b, 22)))));
+      bpp = le16(b, 28);
+      compression = le32(b, 30);
+    }
+    if (compression != 0 && compression != 3) return "";  // run-length data: no fixed size
+    if (w > uint64_t(1) << 24 || h > uint64_t(1) << 24) return "";  // refused by the size check
+    const uint64_t need = offset + (bpp * w + 31) / 32 * 4 * h;
+    return b.size() < need ? message(b.size(), need, "BMP") : "";
+  }
+  // TGA has no magic number: the header fields stb_image accepts, where no other format matched.
+  if (b.size() < 18) return "";
+  const unsigned cmapType = b[1], type = b[2], bpp = b[16];
+  const bool rle = type == 9 || type == 10 || type == 11;
+  if (cmapType > 1 || !((type >= 1 && type <= 3) || rle)) return "";
+  const uint64_t w = le16(b, 12), h = le16(b, 14);
+  if (w == 0 || h == 0 || bpp == 0) return "";
+  const uint64_t entryBytes = (uint64_t(b[7]) + 7) / 8;
+  const uint64_t pixelBytes = (uint64_t(bpp) + 7) / 8;
+  uint64_t p = 18 + uint64_t(b[0]) + (cmapType ? uint64_t(le16(b, 5)) * entryBytes : 0);
+  if (!rle) {
+    const uint64_t need = p + w * h * pixelBytes;
+    return b.size() < need ? message(b.size(), need, "TGA") : "";
+  }
+  // Run-length packets: a count byte, then one pixel (a run) or count pixels (raw).
+  for (uint64_t done = 0; done < w * h;) {
+    if (p >= b.size()) return "truncated TGA data: the run-length packets end before the last pixel";
+    const unsigned c = b[p++];
+    const uint64_t n = (c & 0x7f) + 1;
+    p += (c & 0x80 ? 1 : n) * pixelBytes;
+    done += n;
+  }
+  return p > b.size() ? "truncated TGA data: the run-length packets end before the last pixel" : "";
 }
 
 struct StbiFree {
@@ -566,6 +632,11 @@ Image readImage(const std::string& path, bool srgb, uint64_t maxPixels) {
   // stbi_info reports a top-down BMP's height as negative (as stored); the decoder flips it.
   if (h < 0 && h != std::numeric_limits<int>::min()) h = -h;
   checkSize(path, w, h, maxPixels);
+  // PNG, JPEG, PNM and HDR are checked elsewhere (by stb itself or above); BMP and TGA here.
+  if (!(got >= 1 && (magic[0] == 0x89 || magic[0] == 0xFF || magic[0] == 'P' || magic[0] == '#'))) {
+    std::string why = bmpTgaTruncation(readAll(f.get()));
+    if (!why.empty()) throwDecode(path, why);
+  }
 
   // Ask for 3 channels: stb expands grey and drops alpha.
   if (stbi_is_hdr_from_file(f.get())) {

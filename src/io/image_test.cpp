@@ -368,5 +368,88 @@ TEST(Image, ReadDirectoryIsAnError) {
   EXPECT_THROW(readImage(dir.path()), ImageReadError);
 }
 
+// Issue 23: truncated images decoded as valid (stb reads missing samples as zeros or stale
+// memory): `compare a.png trunc.ppm` reported RMSE 0. The data length is checked against
+// the header now, for each format.
+std::string readError(const std::string& path) {
+  try {
+    readImage(path);
+  } catch (const ImageReadError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::vector<uint8_t> bytesOf(const std::string& header, size_t samples) {
+  std::vector<uint8_t> b(header.begin(), header.end());
+  b.resize(b.size() + samples, 100);
+  return b;
+}
+
+TEST(ImageTruncated, PpmAndPgm) {
+  TempDir dir;
+  writeRaw(dir.file("t.ppm"), bytesOf("P6\n32 32\n255\n", 100));
+  EXPECT_NE(readError(dir.file("t.ppm")).find("truncated PNM data: 100 bytes of samples, the header needs 3072"),
+            std::string::npos)
+      << readError(dir.file("t.ppm"));
+  writeRaw(dir.file("t.pgm"), bytesOf("P5 32 32 255\n", 1023));
+  EXPECT_NE(readError(dir.file("t.pgm")).find("truncated PNM data"), std::string::npos);
+  writeRaw(dir.file("ok.ppm"), bytesOf("P6\n32 32\n255\n", 3072));
+  writeRaw(dir.file("ok.pgm"), bytesOf("P5 32 32 255\n", 1024));
+  EXPECT_EQ(readError(dir.file("ok.ppm")), "");
+  EXPECT_EQ(readError(dir.file("ok.pgm")), "");
+  EXPECT_EQ(readImage(dir.file("ok.ppm")).width, 32);
+}
+
+TEST(ImageTruncated, Bmp) {
+  TempDir dir;
+  std::vector<uint8_t> rgb(size_t(8 * 8 * 3), 200);
+  std::vector<uint8_t> bmp = makeBmp(8, 8, 24, rgb);
+  writeRaw(dir.file("ok.bmp"), bmp);
+  EXPECT_EQ(readError(dir.file("ok.bmp")), "");
+  bmp.resize(bmp.size() - 30);
+  writeRaw(dir.file("t.bmp"), bmp);
+  EXPECT_NE(readError(dir.file("t.bmp")).find("truncated BMP data"), std::string::npos) << readError(dir.file("t.bmp"));
+  // Top-down rows (negative height) are checked the same way.
+  std::vector<uint8_t> topDown = makeBmp(8, -8, 24, rgb);
+  topDown.resize(60);
+  writeRaw(dir.file("td.bmp"), topDown);
+  EXPECT_NE(readError(dir.file("td.bmp")).find("truncated BMP data"), std::string::npos) << readError(dir.file("td.bmp"));
+}
+
+std::vector<uint8_t> tgaHeader(int type, int w, int h) {
+  std::vector<uint8_t> b(18, 0);
+  b[2] = uint8_t(type);
+  b[12] = uint8_t(w);
+  b[14] = uint8_t(h);
+  b[16] = 24;
+  return b;
+}
+
+TEST(ImageTruncated, Tga) {
+  TempDir dir;
+  std::vector<uint8_t> raw = tgaHeader(2, 4, 4);
+  raw.resize(18 + 48, 90);
+  writeRaw(dir.file("ok.tga"), raw);
+  EXPECT_EQ(readError(dir.file("ok.tga")), "");
+  EXPECT_EQ(readImage(dir.file("ok.tga")).width, 4);
+  raw.resize(18 + 10);
+  writeRaw(dir.file("t.tga"), raw);
+  EXPECT_NE(readError(dir.file("t.tga")).find("truncated TGA data"), std::string::npos) << readError(dir.file("t.tga"));
+
+  // Run-length: one run of 16 pixels is whole; a run of 8 and nothing after is not.
+  std::vector<uint8_t> rle = tgaHeader(10, 4, 4);
+  rle.push_back(0x8f);
+  rle.insert(rle.end(), {10, 20, 30});
+  writeRaw(dir.file("ok_rle.tga"), rle);
+  EXPECT_EQ(readError(dir.file("ok_rle.tga")), "");
+  rle = tgaHeader(10, 4, 4);
+  rle.push_back(0x87);
+  rle.insert(rle.end(), {10, 20, 30});
+  writeRaw(dir.file("t_rle.tga"), rle);
+  EXPECT_NE(readError(dir.file("t_rle.tga")).find("truncated TGA data"), std::string::npos)
+      << readError(dir.file("t_rle.tga"));
+}
+
 }  // namespace
 }  // namespace lc::io

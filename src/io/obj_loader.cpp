@@ -12,7 +12,9 @@
 //   - out-of-range and zero indices are errors with a line number (tinyobj only warns,
 //     at the last line, and silently drops such quads),
 //   - non-finite coordinates (nan, inf, 1e999) are errors with a line number (tinyobj
-//     reads "nan" as 0 and lets overflow through as inf).
+//     reads "nan" as 0 and lets overflow through as inf),
+//   - a face of more than 4096 corners is an error with its line number (tinyobj's ear
+//     clipping is quadratic: one face of 200,000 corners took minutes).
 // A similar scan of each MTL (scanMtl) records which keywords each material lists, so
 // that a material overrides only what its MTL block says (tinyobj fills in defaults)
 // and so that textures carry the line they were named on.
@@ -190,6 +192,9 @@ struct ObjScan {
   std::vector<std::string> mtllibArgs;  // raw text after each `mtllib`
 };
 
+// The most corners one face may have (tinyobj triangulates a polygon in quadratic time).
+constexpr int kMaxFaceVertices = 4096;
+
 // Index kinds, for messages.
 const char* const kIndexWhat[3] = {"vertex", "texture coordinate", "normal"};
 const char* const kIndexLine[3] = {"v", "vt", "vn"};
@@ -282,6 +287,12 @@ ObjScan scanObj(const std::string& text, const std::string& path, const Limits& 
         // tinyobj skips blanks and '\r' between corners; anything after the third
         // component up to the next blank was consumed by parseIndex.
       }
+      // tinyobj's ear clipping takes time growing with the square of a polygon's size (a
+      // face of 200,000 corners ran for minutes): larger faces are refused here.
+      if (corners > kMaxFaceVertices)
+        throw Error(SourceLoc{path, lineNo, 0},
+                    "face has " + std::to_string(corners) + " vertices, more than " +
+                        std::to_string(kMaxFaceVertices) + " in one polygon (split it into smaller faces)");
       if (corners >= 3) scan.triangles += uint64_t(corners - 2);
     }
   });

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <string>
@@ -638,6 +639,43 @@ TEST(Obj2Ray, UnwritableOutputFailsBeforeLoading) {
     writeRayFromObj(dataPath("obj/quads.obj"), "/nonexistent-dir/x.ray", Limits{});
   });
   EXPECT_NE(msg.find("cannot write '/nonexistent-dir/x.ray'"), std::string::npos) << msg;
+}
+
+// Issue 23: one polygon of 200,000 corners kept tinyobj's triangulation busy for minutes;
+// faces of more than 4096 corners are refused by the pre-scan, with their line.
+TEST(ObjLoader, HugePolygonIsRefusedQuickly) {
+  TempDir dir;
+  const int n = 100000;
+  std::string text;
+  text.reserve(size_t(n) * 40);
+  for (int i = 0; i < n; ++i) {
+    double a = 2 * 3.14159265358979 * i / n;
+    text += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
+  }
+  text += "f";
+  for (int i = 1; i <= n; ++i) text += " " + std::to_string(i);
+  text += "\n";
+  std::string path = dir.file("huge.obj");
+  writeText(path, text);
+  auto t0 = std::chrono::steady_clock::now();
+  std::string err = errorOf([&] { load(path); });
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_NE(err.find("huge.obj:100001: error: face has 100000 vertices, more than 4096 in one polygon"),
+            std::string::npos)
+      << err;
+  EXPECT_LT(seconds, 1.0);
+
+  // 4096 corners still load (as 4094 triangles).
+  std::string ok;
+  for (int i = 0; i < 4096; ++i) {
+    double a = 2 * 3.14159265358979 * i / 4096;
+    ok += "v " + std::to_string(std::cos(a)) + " " + std::to_string(std::sin(a)) + " 0\n";
+  }
+  ok += "f";
+  for (int i = 1; i <= 4096; ++i) ok += " " + std::to_string(i);
+  ok += "\n";
+  writeText(dir.file("ok.obj"), ok);
+  EXPECT_EQ(errorOf([&] { load(dir.file("ok.obj")); }), "");
 }
 
 }  // namespace

@@ -507,8 +507,10 @@ void fillMesh(const scene::Scene& scene, const Emitter& e, const ObjectLightOpti
     double n = triangleMaterial(m, sh, t) == e.material ? trianglePoints(triangleArea(m, t), density) : 0;
     first[t + 1] = first[t] + uint64_t(n);
   }
+  auto cancelled = [&] { return o.cancel && o.cancel->load(std::memory_order_relaxed); };
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nt, 256), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t < r.end(); ++t) {
+      if (cancelled()) return;
       uint64_t n = first[t + 1] - first[t];
       if (n == 0) continue;
       const auto& tri = m.triangles[t];
@@ -534,12 +536,14 @@ void fillMesh(const scene::Scene& scene, const Emitter& e, const ObjectLightOpti
       }
     }
   });
+  if (cancelled()) throw Interrupted();
 }
 
-void fillQuadric(const Shape& sh, const Emitter& e, const Writer& w) {
+void fillQuadric(const Shape& sh, const Emitter& e, const ObjectLightOptions& o, const Writer& w) {
   AreaScale s(sh);
   uint64_t k = 0;
   auto emit = [&](const D3& local, const D3& nLocal, int part) {
+    if ((k & 0xffff) == 0 && o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Interrupted();
     Vec3 pl = toVec3(local);
     w.put(k++, sh.toWorld.point(pl), worldNormal(sh, nLocal), quadricUv(sh, pl, part));
   };
@@ -686,6 +690,7 @@ std::vector<ObjectLightInfo> addObjectLights(scene::Scene& scene, const ObjectLi
   set.lights.resize(base + size_t(total));
   Progress progress(options.progress, total);
   for (Emitter& e : emitters) {
+    if (options.cancel && options.cancel->load()) throw Interrupted();
     const Luminosity& l = *e.lum;
     LightGroup g;
     g.atten = Attenuation{l.attenConstant, l.attenLinear, l.attenQuadratic, kInf};
@@ -707,7 +712,7 @@ std::vector<ObjectLightInfo> addObjectLights(scene::Scene& scene, const ObjectLi
       fillMesh(scene, e, options, w);
     } else {
       allocate(e.quadric, uint64_t(e.points));
-      fillQuadric(sh, e, w);
+      fillQuadric(sh, e, options, w);
     }
     size_t n = size_t(e.points * perPoint(e));
     ObjectLightInfo info;

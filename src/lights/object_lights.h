@@ -2,6 +2,7 @@
 // on its surface (the seed's "object lights"). See docs/SCENE_FORMAT.md for the keyword.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -29,6 +30,9 @@ struct ObjectLightOptions {
   uint64_t maxLights = 20'000'000;  // --max-lights
   uint64_t seed = 1;  // unused so far: placement is a deterministic function of the geometry
   ProgressFn progress = {};  // called with the share of lights placed (core/progress.h)
+  // When set and it becomes true, placement stops within a block of lights and
+  // addObjectLights throws lc::Interrupted.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 // What was generated for one luminous object (for `lightcuts info` and --stats).

@@ -125,7 +125,9 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
   std::vector<std::vector<Deposit>> out(blocks);
   const float eps = scene.epsilon();
   Progress progress(o.progress, double(n));
+  auto cancelled = [&] { return o.cancel && o.cancel->load(std::memory_order_relaxed); };
   tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+    if (cancelled()) return;
     std::vector<Deposit>& dep = out[b];
     for (size_t p = b * kBlock; p < std::min(n, (b + 1) * kBlock); ++p) {
       Rng rng(o.seed, p);
@@ -188,6 +190,7 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
     progress.add(double(std::min(n, (b + 1) * kBlock) - b * kBlock));
   });
   progress.finish();
+  if (cancelled()) throw Interrupted();
 
   size_t count = 0;
   for (const auto& d : out) count += d.size();

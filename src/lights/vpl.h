@@ -3,6 +3,7 @@
 // whose colour is the carried power times the surface's diffuse colour.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <string>
 
@@ -25,6 +26,9 @@ struct VplOptions {
   uint64_t seed = 1;
   uint64_t maxVpls = 10'000'000;
   ProgressFn progress = {};  // called with the share of paths shot (core/progress.h)
+  // When set and it becomes true, shooting stops within a block of paths and addVpls throws
+  // lc::Interrupted (the scene's lights are left as they were).
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct VplInfo {

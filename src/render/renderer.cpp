@@ -525,6 +525,7 @@ struct ReconstructionTile {
       for (int x = cx; x < cx + w; ++x) {
         uint8_t& st = state[slot(x, y)];
         if (st & kDone) continue;
+        if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
         hook.px = x;
         hook.py = y;
         int shape = -1;
@@ -680,9 +681,12 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
         int x0 = tx * kTile, y0 = ty * kTile;
         int x1 = std::min(o.width, (tx + 1) * kTile), y1 = std::min(o.height, (ty + 1) * kTile);
         if (!recon) {
+          // Cancellation is checked at every pixel: one tile of many samples can take seconds.
           for (int y = y0; y < y1; ++y)
-            for (int x = x0; x < x1; ++x)
+            for (int x = x0; x < x1; ++x) {
+              if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
               storePixel(res, o.width, x, y, renderPixel(scene, evaluator, o, x, y, L.stats, L.primary, L.secondary));
+            }
           ++tilesDone;
           continue;
         }
@@ -701,7 +705,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   cv.notify_all();
   if (reporter.joinable()) reporter.join();
   if (o.progress) o.progress(double(tilesDone) / double(totalTiles));
-  // A cancelled render may stop inside a tile (reconstruction tiles check between cells).
+  // A cancelled render may stop inside a tile (tiles check at every pixel).
   res.interrupted = o.cancel && o.cancel->load() && std::find(res.done.begin(), res.done.end(), 0) != res.done.end();
 
   for (const Local& L : locals) {
