@@ -203,7 +203,7 @@ class Parser {
   // `emission = (r,g,b)`: reads the value (after the key), components finite and >= 0.
   Color emissionValue();
   // Makes `m` emit radiance `le`: emissive = le (the camera sees it) and a per-area
-  // luminosity { colour = le; intensity = 1; per_area; density = --emission-density }.
+  // luminosity { colour = le; intensity = 1/pi; per_area; density = --emission-density }.
   void applyEmission(MaterialDesc& m, const Color& le, const Token& at) const;
   // A copy of material `index` (unnamed) with `emission = le` applied; returns its index.
   int emissiveCopy(int index, const Color& le, const Token& at);
@@ -1130,7 +1130,9 @@ void Parser::applyEmission(MaterialDesc& m, const Color& le, const Token& at) co
   }
   LuminosityDesc l;
   l.colour = ColorParam{le, std::nullopt};
-  l.intensity = 1;
+  // Total intensity A Le / pi: this renderer's diffuse term has no 1/pi (kd I cos / d^2), so
+  // a lit surface comes out as bright as under a path tracer's kd / pi (docs/SCENE_FORMAT.md).
+  l.intensity = float(1 / 3.14159265358979323846);
   l.perArea = true;
   l.density = opt_.emissionDensity;
   l.loc = lex_.loc(at);

@@ -1348,7 +1348,7 @@ TEST(RayParserEmission, ObjectMaterialAndSphereLight) {
   EXPECT_TRUE(t.emissiveSet);
   ASSERT_TRUE(t.luminosity);
   EXPECT_TRUE(t.luminosity->perArea);
-  EXPECT_EQ(t.luminosity->intensity, 1);
+  EXPECT_FLOAT_EQ(t.luminosity->intensity, float(1 / 3.14159265358979323846));  // A Le / pi in all
   EXPECT_EQ(t.luminosity->density, 3);
   expectVec(t.luminosity->colour.value, 1, 2, 3);
   expectVec(materialOf(s, 1).luminosity->colour.value, 4, 4, 4);  // emission before material

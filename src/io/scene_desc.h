@@ -41,8 +41,8 @@ struct ScalarParam {
 //   density    point lights per unit of world-space area, default 1
 //   constant/linear/quadratic_attenuation_coeff  default 0, 0, 1
 //   per_area   intensity is per unit of world-space area (default false): the object's total
-//              is intensity x area. `emission = Le` (COMP4411) makes colour = Le, intensity 1,
-//              per_area true: an area A at radiance Le gets total intensity A x Le.
+//              is intensity x area. `emission = Le` (COMP4411) makes colour = Le, intensity 1/pi,
+//              per_area true: an area A gets total intensity A x intensity.
 struct LuminosityDesc {
   ColorParam colour{Color(1, 1, 1), std::nullopt};
   bool colourFromDiffuse = false;  // `colour = texture`: use the material's diffuse map

@@ -775,7 +775,7 @@ std::string lightcutsBinary() {
 }
 
 // `emission = Le` (COMP4411) is a per-area luminosity: an area A at radiance Le gets total
-// intensity A x Le (flux pi A Le), on each side of a two-sided emitter; the camera sees Le.
+// intensity A x Le / pi, on each side of a two-sided emitter; the camera sees Le.
 TEST(ObjectLights, EmissionIsRadianceTimesArea) {
   Built b = build(
       // a 2 x 2 panel (object-level emission, as COMP4411's trimesh)
@@ -791,12 +791,12 @@ TEST(ObjectLights, EmissionIsRadianceTimesArea) {
   auto near = [](Color got, Color want, double rel) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], rel * std::max(1.0f, want[c])) << c;
   };
-  near(b.info[0].power, Color(8, 4, 2), 1e-5);
+  const float ip = float(1 / kPiD);
+  near(b.info[0].power, Color(8, 4, 2) * ip, 1e-5);
   EXPECT_NEAR(b.info[0].area, 4, 1e-6);
-  const double sphere = 16 * kPiD;
-  near(b.info[1].power, Color(float(sphere), float(2 * sphere), float(3 * sphere)), 1e-5);
-  near(b.info[2].power, Color(18, 18, 18), 1e-5);  // 9 on each side
-  near(b.info[3].power, Color(float(kPiD), float(kPiD), float(kPiD)), 1e-5);
+  near(b.info[1].power, Color(16, 32, 48), 1e-5);  // area 16 pi
+  near(b.info[2].power, Color(18, 18, 18) * ip, 1e-5);  // 9 on each side
+  near(b.info[3].power, Color(1, 1, 1), 1e-5);  // area pi
   // Density: --emission-density (ParseOptions::emissionDensity) lights per unit area.
   EXPECT_EQ(b.info[0].lights, 4u);
   io::ParseOptions po;
@@ -807,7 +807,7 @@ TEST(ObjectLights, EmissionIsRadianceTimesArea) {
       "t.ray", "/base", po));
   ASSERT_EQ(dense.info.size(), 1u);
   EXPECT_EQ(dense.info[0].lights, 100u);
-  near(dense.info[0].power, Color(8, 4, 2), 1e-5);
+  near(dense.info[0].power, Color(8, 4, 2) * ip, 1e-5);
   // The camera sees the emitters at Le.
   scene::Hit h;
   ASSERT_TRUE(b.scene->intersect(scene::Ray{Vec3(0.3f, 0.2f, 5), Vec3(0, 0, -1)}, h));
@@ -829,8 +829,9 @@ TEST(ObjectLights, EmissionIsRadianceTimesArea) {
 TEST(ObjectLights, EmittingSquareOverAPlaneMatchesTheClosedForm) {
   const double a = 0.5, hgt = 2, kd = 0.5, le = 3;
   const double X = a / hgt, r = std::sqrt(1 + X * X);
-  const double want = kd * le * 4 * X / r * std::atan(X / r);
-  EXPECT_NEAR(want, kd * le * 4 * a * a / (hgt * hgt), 0.1 * want);  // small-source limit (8% here)
+  // Irradiance E of a square of radiance Le, and the path tracer's kd / pi x E.
+  const double want = kd / kPiD * le * 4 * X / r * std::atan(X / r);
+  EXPECT_NEAR(want, kd / kPiD * le * 4 * a * a / (hgt * hgt), 0.1 * want);  // small-source limit (8% here)
   const std::string body =
       "camera { position = (0, -4, 1); look_at = (0, 0, 0); fov = 10; }\n"
       "trimesh { material = { diffuse = (0.5, 0.5, 0.5); };"
