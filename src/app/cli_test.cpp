@@ -469,6 +469,28 @@ TEST_P(ErrorCatalogue, MessageStatusAndNoOutput) {
 INSTANTIATE_TEST_SUITE_P(Rows, ErrorCatalogue, ::testing::ValuesIn(catalogue()),
                          [](const ::testing::TestParamInfo<Row>& i) { return i.param.name; });
 
+// Issue 26: `lightcuts` alone prints the help (the subcommands, one line each) on stdout
+// and exits 0, as --help does; it used to say only "A subcommand is required".
+TEST(CliUsage, NoSubcommandPrintsTheHelp) {
+  TempDir dir;
+  CliResult r = run({}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_NE(r.out.find("Subcommands:"), std::string::npos) << r.out;
+  for (const char* cmd : {"render", "info", "compare", "obj2ray"}) {
+    size_t at = r.out.find(std::string("\n  ") + cmd + " ");
+    ASSERT_NE(at, std::string::npos) << cmd << " is not listed:\n" << r.out;
+    size_t eol = r.out.find('\n', at + 1);
+    std::string line = r.out.substr(at + 1, eol - at - 1);
+    EXPECT_GT(line.size(), std::string(cmd).size() + 10) << "no description on the line of " << cmd;
+  }
+  EXPECT_EQ(r.out.find("A subcommand is required"), std::string::npos) << r.out;
+  // --help prints the same.
+  CliResult h = run({"--help"}, dir.path());
+  EXPECT_EQ(h.status, 0);
+  EXPECT_EQ(h.out, r.out);
+}
+
 // A usage error is CLI11's: its own message and status (not 1), and no output.
 TEST(CliUsage, UnknownOptionIsAUsageError) {
   TempDir dir;
