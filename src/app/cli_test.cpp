@@ -407,6 +407,15 @@ std::vector<Row> catalogue() {
   }
   {
     Row r;
+    r.name = "obj2ray_default_output_is_input";
+    r.files = {{"in.ray", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"}};
+    r.args = {"obj2ray", "in.ray"};
+    r.message = "'in.ray' is given as both the input OBJ and the default output (the input with .ray; choose another "
+                "with -o); use different files";
+    rows.push_back(r);
+  }
+  {
+    Row r;
     r.name = "heatmap_overwrites_reference";
     r.files = {{"a.ppm", "P6\n1 1\n255\nabc"}, {"b.ppm", "P6\n1 1\n255\nabc"}};
     r.args = {"compare", "a.ppm", "b.ppm", "--heatmap", "a.ppm"};
@@ -489,6 +498,20 @@ TEST(CliUsage, NoSubcommandPrintsTheHelp) {
   CliResult h = run({"--help"}, dir.path());
   EXPECT_EQ(h.status, 0);
   EXPECT_EQ(h.out, r.out);
+}
+
+// Issue 26: obj2ray without -o writes IN with its extension replaced by .ray, next to IN.
+TEST(CliObj2Ray, DefaultOutputIsTheInputWithRayExtension) {
+  TempDir dir;
+  fs::create_directories(dir.file("models"));
+  writeText(dir.file("models/cube.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  CliResult r = run({"obj2ray", "models/cube.obj"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "wrote models/cube.ray\n");
+  ASSERT_TRUE(fs::exists(dir.file("models/cube.ray")));
+  EXPECT_EQ(slurp(dir.file("models/cube.ray")).rfind(kHeader, 0), 0u);
+  CliResult h = run({"obj2ray", "--help"}, dir.path());
+  EXPECT_NE(h.out.find("default: the input with its extension replaced by .ray"), std::string::npos) << h.out;
 }
 
 // A usage error is CLI11's: its own message and status (not 1), and no output.
