@@ -15,6 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -512,6 +513,41 @@ TEST(CliObj2Ray, DefaultOutputIsTheInputWithRayExtension) {
   EXPECT_EQ(slurp(dir.file("models/cube.ray")).rfind(kHeader, 0), 0u);
   CliResult h = run({"obj2ray", "--help"}, dir.path());
   EXPECT_NE(h.out.find("default: the input with its extension replaced by .ray"), std::string::npos) << h.out;
+}
+
+// Issue 26: `render --help` is grouped (Output, Image, Lightcuts, Reconstruction, Scene,
+// Lights & GI, Limits) and every option states its default; every option keeps its name.
+TEST(CliUsage, RenderHelpIsGroupedAndStatesEveryDefault) {
+  TempDir dir;
+  CliResult r = run({"render", "--help"}, dir.path());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string& h = r.out;
+  std::vector<size_t> at;
+  for (const char* g : {"Output:", "Image:", "Lightcuts:", "Reconstruction:", "Scene:", "Lights & GI:", "Limits:"}) {
+    at.push_back(h.find(std::string("\n") + g + "\n"));
+    EXPECT_NE(at.back(), std::string::npos) << "no group " << g << ":\n" << h;
+  }
+  EXPECT_TRUE(std::is_sorted(at.begin(), at.end())) << h;
+  for (const char* name :
+       {"-o,--output", "--stats", "--cut-heatmap", "--tonemap", "-q,--quiet", "--width", "--height", "--spp",
+        "--max-depth", "--threads", "--seed", "--method", "--tree", "--error", "--max-cut", "--cut-criterion",
+        "--estimator", "--visibility-probes", "--reference-pixels", "--reconstruct", "--reconstruct-coarse",
+        "--lenient", "--object-lights", "--object-light-placement", "--emission-density", "--default-attenuation",
+        "--vpls", "--bounces", "--vpl-normalize", "--vpl-clamp", "--gi", "--max-lights", "--max-vpls",
+        "--max-triangles", "--max-nesting", "--max-objects", "--max-image-pixels", "--max-texture-pixels"}) {
+    size_t p = h.find(std::string("\n  ") + name + " ");
+    ASSERT_NE(p, std::string::npos) << name << " is missing:\n" << h;
+    // The option's entry: up to the next option or group (a long name puts the text on a line of its own).
+    size_t next = std::min(h.find("\n  -", p + 1), h.find("\n\n", p + 1));
+    std::string entry = h.substr(p + 1, next - p - 1);
+    EXPECT_NE(entry.find("default"), std::string::npos) << "no default stated: " << entry;
+  }
+  // A few values, as the code defines them.
+  EXPECT_NE(h.find("Most nodes in one cut; default 4000"), std::string::npos) << h;
+  EXPECT_NE(h.find("default 512, or from --height"), std::string::npos) << h;
+  EXPECT_NE(h.find("Limit on VPLs; default 10000000"), std::string::npos) << h;
+  EXPECT_NE(h.find("default auto: 4 for images of 512 x 512 pixels or more"), std::string::npos) << h;
+  EXPECT_NE(h.find("default the scene's, else 0.05"), std::string::npos) << h;
 }
 
 // A usage error is CLI11's: its own message and status (not 1), and no output.
