@@ -15,6 +15,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
@@ -407,6 +408,15 @@ std::vector<Row> catalogue() {
   }
   {
     Row r;
+    r.name = "obj2ray_default_output_is_input";
+    r.files = {{"in.ray", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"}};
+    r.args = {"obj2ray", "in.ray"};
+    r.message = "'in.ray' is given as both the input OBJ and the default output (the input with .ray; choose another "
+                "with -o); use different files";
+    rows.push_back(r);
+  }
+  {
+    Row r;
     r.name = "heatmap_overwrites_reference";
     r.files = {{"a.ppm", "P6\n1 1\n255\nabc"}, {"b.ppm", "P6\n1 1\n255\nabc"}};
     r.args = {"compare", "a.ppm", "b.ppm", "--heatmap", "a.ppm"};
@@ -468,6 +478,77 @@ TEST_P(ErrorCatalogue, MessageStatusAndNoOutput) {
 
 INSTANTIATE_TEST_SUITE_P(Rows, ErrorCatalogue, ::testing::ValuesIn(catalogue()),
                          [](const ::testing::TestParamInfo<Row>& i) { return i.param.name; });
+
+// Issue 26: `lightcuts` alone prints the help (the subcommands, one line each) on stdout
+// and exits 0, as --help does; it used to say only "A subcommand is required".
+TEST(CliUsage, NoSubcommandPrintsTheHelp) {
+  TempDir dir;
+  CliResult r = run({}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  EXPECT_NE(r.out.find("Subcommands:"), std::string::npos) << r.out;
+  for (const char* cmd : {"render", "info", "compare", "obj2ray"}) {
+    size_t at = r.out.find(std::string("\n  ") + cmd + " ");
+    ASSERT_NE(at, std::string::npos) << cmd << " is not listed:\n" << r.out;
+    size_t eol = r.out.find('\n', at + 1);
+    std::string line = r.out.substr(at + 1, eol - at - 1);
+    EXPECT_GT(line.size(), std::string(cmd).size() + 10) << "no description on the line of " << cmd;
+  }
+  EXPECT_EQ(r.out.find("A subcommand is required"), std::string::npos) << r.out;
+  // --help prints the same.
+  CliResult h = run({"--help"}, dir.path());
+  EXPECT_EQ(h.status, 0);
+  EXPECT_EQ(h.out, r.out);
+}
+
+// Issue 26: obj2ray without -o writes IN with its extension replaced by .ray, next to IN.
+TEST(CliObj2Ray, DefaultOutputIsTheInputWithRayExtension) {
+  TempDir dir;
+  fs::create_directories(dir.file("models"));
+  writeText(dir.file("models/cube.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  CliResult r = run({"obj2ray", "models/cube.obj"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "wrote models/cube.ray\n");
+  ASSERT_TRUE(fs::exists(dir.file("models/cube.ray")));
+  EXPECT_EQ(slurp(dir.file("models/cube.ray")).rfind(kHeader, 0), 0u);
+  CliResult h = run({"obj2ray", "--help"}, dir.path());
+  EXPECT_NE(h.out.find("default: the input with its extension replaced by .ray"), std::string::npos) << h.out;
+}
+
+// Issue 26: `render --help` is grouped (Output, Image, Lightcuts, Reconstruction, Scene,
+// Lights & GI, Limits) and every option states its default; every option keeps its name.
+TEST(CliUsage, RenderHelpIsGroupedAndStatesEveryDefault) {
+  TempDir dir;
+  CliResult r = run({"render", "--help"}, dir.path());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string& h = r.out;
+  std::vector<size_t> at;
+  for (const char* g : {"Output:", "Image:", "Lightcuts:", "Reconstruction:", "Scene:", "Lights & GI:", "Limits:"}) {
+    at.push_back(h.find(std::string("\n") + g + "\n"));
+    EXPECT_NE(at.back(), std::string::npos) << "no group " << g << ":\n" << h;
+  }
+  EXPECT_TRUE(std::is_sorted(at.begin(), at.end())) << h;
+  for (const char* name :
+       {"-o,--output", "--stats", "--cut-heatmap", "--tonemap", "-q,--quiet", "--width", "--height", "--spp",
+        "--max-depth", "--threads", "--seed", "--method", "--tree", "--error", "--max-cut", "--cut-criterion",
+        "--estimator", "--visibility-probes", "--reference-pixels", "--reconstruct", "--reconstruct-coarse",
+        "--lenient", "--object-lights", "--object-light-placement", "--emission-density", "--default-attenuation",
+        "--vpls", "--bounces", "--vpl-normalize", "--vpl-clamp", "--gi", "--max-lights", "--max-vpls",
+        "--max-triangles", "--max-nesting", "--max-objects", "--max-image-pixels", "--max-texture-pixels"}) {
+    size_t p = h.find(std::string("\n  ") + name + " ");
+    ASSERT_NE(p, std::string::npos) << name << " is missing:\n" << h;
+    // The option's entry: up to the next option or group (a long name puts the text on a line of its own).
+    size_t next = std::min(h.find("\n  -", p + 1), h.find("\n\n", p + 1));
+    std::string entry = h.substr(p + 1, next - p - 1);
+    EXPECT_NE(entry.find("default"), std::string::npos) << "no default stated: " << entry;
+  }
+  // A few values, as the code defines them.
+  EXPECT_NE(h.find("Most nodes in one cut; default 4000"), std::string::npos) << h;
+  EXPECT_NE(h.find("default 512, or from --height"), std::string::npos) << h;
+  EXPECT_NE(h.find("Limit on VPLs; default 10000000"), std::string::npos) << h;
+  EXPECT_NE(h.find("default auto: 4 for images of 512 x 512 pixels or more"), std::string::npos) << h;
+  EXPECT_NE(h.find("default the scene's, else 0.05"), std::string::npos) << h;
+}
 
 // A usage error is CLI11's: its own message and status (not 1), and no output.
 TEST(CliUsage, UnknownOptionIsAUsageError) {

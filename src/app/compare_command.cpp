@@ -1,6 +1,8 @@
 // `lightcuts compare`: error metrics between a reference and a test image.
 #include <fmt/format.h>
 
+#include <filesystem>
+
 #include "app/commands.h"
 #include "core/file_util.h"
 #include "io/colormap.h"
@@ -64,14 +66,28 @@ void addCompareCommand(CLI::App& app) {
   c->callback([a] { exitStatus() = runCompare(*a); });
 }
 
+// obj2ray's output when -o is not given: the input with its extension replaced by .ray, in
+// the input's folder ("models/cube.obj" -> "models/cube.ray", "cube" -> "cube.ray").
+std::string defaultRayOutput(const std::string& input) {
+  return std::filesystem::path(input).replace_extension(".ray").string();
+}
+
 void addObj2RayCommand(CLI::App& app) {
   auto in = std::make_shared<std::string>();
   auto out = std::make_shared<std::string>();
   CLI::App* c = app.add_subcommand("obj2ray", "Convert an OBJ/MTL model to an equivalent .ray scene");
   c->add_option("input", *in, "OBJ file")->required();
-  c->add_option("-o,--output", *out, "Output .ray file")->required();
+  c->add_option("-o,--output", *out,
+                "Output .ray file (default: the input with its extension replaced by .ray, in the input's folder: "
+                "model.obj -> model.ray)");
   c->callback([in, out] {
-    checkDistinctPaths({{*in, "the input OBJ"}, {*out, "-o"}});
+    if (out->empty()) {
+      *out = defaultRayOutput(*in);
+      // A default that would overwrite the input (IN is already .ray) is refused, not written.
+      checkDistinctPaths({{*in, "the input OBJ"}, {*out, "the default output (the input with .ray; choose another with -o)"}});
+    } else {
+      checkDistinctPaths({{*in, "the input OBJ"}, {*out, "-o"}});
+    }
     io::writeRayFromObj(*in, *out, Limits{});
     fmt::print("wrote {}\n", *out);
     exitStatus() = 0;

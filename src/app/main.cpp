@@ -16,7 +16,8 @@ int& exitStatus() {
 int main(int argc, char** argv) {
   CLI::App app{"lightcuts: a ray tracer for the SBT .ray format that renders thousands to millions of lights "
                "with Lightcuts (Walter et al. 2005), the course project's cuts, or brute force"};
-  app.require_subcommand(1);
+  // At most one subcommand; none prints the help (below).
+  app.require_subcommand(0, 1);
   app.set_version_flag("--version", "lightcuts 0.1.0");
   lc::app::addRenderCommand(app);
   lc::app::addInfoCommand(app);
@@ -24,6 +25,9 @@ int main(int argc, char** argv) {
   lc::app::addObj2RayCommand(app);
   try {
     app.parse(argc, argv);
+    // No subcommand: the help, as for --help (stdout, status 0), rather than CLI11's
+    // "A subcommand is required" that leaves the user to guess the commands.
+    if (app.get_subcommands().empty()) throw CLI::CallForHelp();
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   } catch (const lc::Error& e) {

@@ -26,6 +26,7 @@ namespace lc::app {
 namespace {
 
 constexpr int kMaxImageSide = 1 << 16;  // --width, --height and sizes from the aspect ratio
+constexpr int kDefaultWidth = 512;      // when neither --width nor --height is given
 
 
 struct RenderArgs {
@@ -66,17 +67,21 @@ constexpr float kSeedDefaultError = 0.25f;
 // borrowed visibility misses: on the 100,000-light scaling scene at 256 x 256, 2.0% of
 // pixels come out more than 2% off with them and 0.8% without (docs/LIGHTCUTS.md); small
 // images are cheap either way.
+constexpr int kAutoReconstructSpacing = 4;
+constexpr int kAutoReconstructMinSide = 512;  // from kAutoReconstructMinSide^2 pixels up
 int reconstructSpacing(const std::string& option, int width, int height) {
   if (option != "auto") return std::stoi(option);
-  return int64_t(width) * height >= 512 * 512 ? 4 : 0;
+  return int64_t(width) * height >= int64_t(kAutoReconstructMinSide) * kAutoReconstructMinSide ? kAutoReconstructSpacing
+                                                                                               : 0;
 }
 
 // --reconstruct-coarse auto: cells twice the spacing where their corners agree (see
 // RenderOptions::reconstructCoarseSpacing); on the green emitter a third fewer samples
 // for the same error. N must be the spacing times a power of two, 0 = none.
+constexpr int kAutoCoarseFactor = 2;
 int reconstructCoarseSpacing(const std::string& option, int spacing) {
   if (spacing <= 1) return 0;
-  if (option == "auto") return 2 * spacing;
+  if (option == "auto") return kAutoCoarseFactor * spacing;
   int c = std::stoi(option);
   if (c == 0) return 0;
   int m = spacing;
@@ -143,7 +148,7 @@ int runRender(RenderArgs& a) {
   // In double, checked against the flags' bound before converting: an aspect ratio of 3e9
   // would otherwise overflow int (and wrap to a 1-pixel or negative size).
   double aspect = cam.aspectRatio ? double(*cam.aspectRatio) : 1.0;
-  if (a.width <= 0 && a.height <= 0) a.width = 512;
+  if (a.width <= 0 && a.height <= 0) a.width = kDefaultWidth;
   if (a.width <= 0 || a.height <= 0) {
     bool fromWidth = a.width > 0;
     double other = std::max(1.0, std::round(fromWidth ? a.width / aspect : a.height * aspect));
@@ -351,54 +356,42 @@ int runRender(RenderArgs& a) {
 
 void addRenderCommand(CLI::App& app) {
   auto a = std::make_shared<RenderArgs>();
+  // Every default below is read from where it lives (RenderArgs' initialisers, the
+  // constants above), so the help cannot drift from what the command does.
+  const RenderArgs& d = *a;
+  const std::string output = "Output", image = "Image", cuts = "Lightcuts", recon = "Reconstruction";
   CLI::App* c = app.add_subcommand("render", "Render a .ray or .obj scene to an image");
   c->add_option("scene", a->scene, "Scene file (.ray or .obj)")->required();
-  c->add_option("-o,--output", a->out, "Output image: .png .ppm .bmp (8-bit) or .exr (float); default <scene>.png");
-  c->add_option("--width", a->width, "Image width in pixels (default 512; or from --height and the aspect ratio)")
-      ->check(CLI::Range(1, kMaxImageSide));
-  c->add_option("--height", a->height, "Image height in pixels (default: width / aspect ratio)")
-      ->check(CLI::Range(1, kMaxImageSide));
-  c->add_option("--spp", a->spp, "Samples per pixel, stratified (1 = pixel centre)")->check(CLI::Range(1, 65536));
-  c->add_option("--threads", a->threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 1024));
-  c->add_option("--max-depth", a->maxDepth, "Reflection/refraction recursion depth")->check(CLI::Range(0, 64));
-  c->add_option("--stats", a->stats, "Write statistics as JSON to this file");
-  c->add_flag("-q,--quiet", a->quiet, "No progress bar or summary");
-  c->add_option("--method", a->method, "Direct lighting: lightcuts (Walter et al. 2005), seed (the course project's cuts) or brute")
-      ->check(CLI::IsMember({"lightcuts", "seed", "brute"}));
-  c->add_option("--tree", a->tree, "Light tree: walter (agglomerative) or seed (k-d split); default by method")
-      ->check(CLI::IsMember({"walter", "agglomerative", "seed"}));
-  c->add_option("--error", a->error, "Error threshold: relative bound for lightcuts (default 0.02); radius/distance for seed (default 0.25)")
-      ->check(CLI::Range(0.0, 1e6));
-  c->add_option("--max-cut", a->maxCut, "Most nodes in one cut (default 4000)")->check(CLI::Range(1, 1 << 30));
-  c->add_option("--cut-criterion", a->criterion,
-                "When a lightcut stops: total (every bound below error x estimate and the root-sum-square of the error spreads below 1.6 x that, default) "
-                "or walter (every bound below error x estimate, as published)")
-      ->check(CLI::IsMember({"total", "walter"}));
-  c->add_option("--estimator", a->estimator,
-                "A cluster's estimate (lightcuts): first-order (its representative's, less the first-order "
-                "change from the cluster's mean light, where smooth; default) or representative (as published)")
-      ->check(CLI::IsMember({"first-order", "representative"}));
-  c->add_option("--visibility-probes", a->visibilityProbes,
-                "Lightcuts: before refining a cluster whose representative is hidden, test the corners of its box; "
-                "when one convex object hides them all, the cluster stays in the cut as hidden (on, default) or "
-                "off (as published)")
-      ->check(CLI::IsMember({"on", "off"}));
-  c->add_option("--reconstruct", a->reconstruct,
-                "Reconstruction cuts (lightcuts): full cuts every N pixels in x and y, primary hits between them "
-                "borrow their visibility (Walter et al. 2005 sec. 5); 0 = a full cut at every point; auto (default) "
-                "= 4 for images of 512 x 512 pixels or more, else 0")
-      ->check(CLI::IsMember({"auto"}) | CLI::Range(0, 1024));
-  c->add_option("--reconstruct-coarse", a->reconstructCoarse,
-                "Reconstruction cuts: cells of M pixels first, kept whole where their four corner samples lie on one "
-                "surface and disagree about little of their light, else split down to N; M = N times a power of two, "
-                "0 = off, auto (default) = 2N")
-      ->check(CLI::IsMember({"auto"}) | CLI::Range(0, 1 << 16));
-  c->add_option("--cut-heatmap", a->cutHeatmap, "Write the per-pixel cut size, colour-mapped with a legend, to this PNG");
-  c->add_option("--reference-pixels", a->referencePixels,
-                "Also run brute force at K pixels: report the measured error and the estimated brute-force time")
-      ->check(CLI::Range(0, 1 << 24));
-  c->add_option("--tonemap", a->tonemap, "8-bit output: clamp (the course renderer's) or srgb")
-      ->check(CLI::IsMember({"clamp", "srgb"}));
+  c->add_option("-o,--output", a->out,
+                "Output image: .png .ppm .bmp (8-bit) or .exr (float); default the scene's name with .png, in the "
+                "current folder")
+      ->group(output);
+  c->add_option("--stats", a->stats, "Write statistics as JSON to this file; default none")->group(output);
+  c->add_option("--cut-heatmap", a->cutHeatmap,
+                "Write the per-pixel cut size, colour-mapped with a legend, to this PNG; default none")
+      ->group(output);
+  c->add_option("--tonemap", a->tonemap, fmt::format("8-bit output: clamp (the course renderer's) or srgb; default {}", d.tonemap))
+      ->check(CLI::IsMember({"clamp", "srgb"}))
+      ->group(output);
+  c->add_flag("-q,--quiet", a->quiet, fmt::format("No progress bar or summary; default {}", d.quiet ? "on" : "off"))
+      ->group(output);
+  c->add_option("--width", a->width,
+                fmt::format("Image width in pixels; default {}, or from --height and the aspect ratio", kDefaultWidth))
+      ->check(CLI::Range(1, kMaxImageSide))
+      ->group(image);
+  c->add_option("--height", a->height, "Image height in pixels; default the width / the camera's aspect ratio")
+      ->check(CLI::Range(1, kMaxImageSide))
+      ->group(image);
+  c->add_option("--spp", a->spp, fmt::format("Samples per pixel, stratified (1 = pixel centre); default {}", d.spp))
+      ->check(CLI::Range(1, 65536))
+      ->group(image);
+  c->add_option("--max-depth", a->maxDepth, fmt::format("Reflection/refraction recursion depth; default {}", d.maxDepth))
+      ->check(CLI::Range(0, 64))
+      ->group(image);
+  c->add_option("--threads", a->threads,
+                fmt::format("Worker threads (0 = all cores); default {}", d.threads))
+      ->check(CLI::Range(0, 1024))
+      ->group(image);
   // The VPLs are shot while the scene loads: an explicit --seed goes there too, over the
   // scene's instant_radiosity seed.
   auto setSeed = [a](const uint64_t& v) {
@@ -406,7 +399,65 @@ void addRenderCommand(CLI::App& app) {
     a->load.vplSeed = v;
   };
   c->add_option_function<uint64_t>("--seed", setSeed,
-                                   "Random seed (sampling, representatives, VPL paths; overrides instant_radiosity's seed); default 1");
+                                   fmt::format("Random seed (sampling, representatives, VPL paths; overrides "
+                                               "instant_radiosity's seed); default {}", d.seed))
+      ->group(image);
+  c->add_option("--method", a->method,
+                fmt::format("Direct lighting: lightcuts (Walter et al. 2005), seed (the course project's cuts) or "
+                            "brute; default {}", d.method))
+      ->check(CLI::IsMember({"lightcuts", "seed", "brute"}))
+      ->group(cuts);
+  c->add_option("--tree", a->tree,
+                fmt::format("Light tree: walter (agglomerative) or seed (k-d split); default {} for --method seed, "
+                            "else {}", lightcuts::treeBuilderName(lightcuts::TreeBuilder::Seed),
+                            lightcuts::treeBuilderName(lightcuts::TreeBuilder::Agglomerative)))
+      ->check(CLI::IsMember({"walter", "agglomerative", "seed"}))
+      ->group(cuts);
+  c->add_option("--error", a->error,
+                fmt::format("Error threshold: relative bound for lightcuts (default {}); radius/distance for seed "
+                            "(default {})", kLightcutsDefaultError, kSeedDefaultError))
+      ->check(CLI::Range(0.0, 1e6))
+      ->group(cuts);
+  c->add_option("--max-cut", a->maxCut, fmt::format("Most nodes in one cut; default {}", d.maxCut))
+      ->check(CLI::Range(1, 1 << 30))
+      ->group(cuts);
+  c->add_option("--cut-criterion", a->criterion,
+                fmt::format("When a lightcut stops: total (every bound below error x estimate and the root-sum-square "
+                            "of the error spreads below 1.6 x that) or walter (every bound below error x estimate, as "
+                            "published); default {}", d.criterion))
+      ->check(CLI::IsMember({"total", "walter"}))
+      ->group(cuts);
+  c->add_option("--estimator", a->estimator,
+                fmt::format("A cluster's estimate (lightcuts): first-order (its representative's, less the first-order "
+                            "change from the cluster's mean light, where smooth) or representative (as published); "
+                            "default {}", d.estimator))
+      ->check(CLI::IsMember({"first-order", "representative"}))
+      ->group(cuts);
+  c->add_option("--visibility-probes", a->visibilityProbes,
+                fmt::format("Lightcuts: before refining a cluster whose representative is hidden, test the corners of "
+                            "its box; when one convex object hides them all, the cluster stays in the cut as hidden "
+                            "(on) or not (off, as published); default {}", d.visibilityProbes))
+      ->check(CLI::IsMember({"on", "off"}))
+      ->group(cuts);
+  c->add_option("--reference-pixels", a->referencePixels,
+                fmt::format("Also run brute force at K pixels: report the measured error and the estimated "
+                            "brute-force time; default {} (none)", d.referencePixels))
+      ->check(CLI::Range(0, 1 << 24))
+      ->group(cuts);
+  c->add_option("--reconstruct", a->reconstruct,
+                fmt::format("Reconstruction cuts (lightcuts): full cuts every N pixels in x and y, primary hits "
+                            "between them borrow their visibility (Walter et al. 2005 sec. 5); 0 = a full cut at "
+                            "every point; default {}: {} for images of {} x {} pixels or more, else 0",
+                            d.reconstruct, kAutoReconstructSpacing, kAutoReconstructMinSide, kAutoReconstructMinSide))
+      ->check(CLI::IsMember({"auto"}) | CLI::Range(0, 1024))
+      ->group(recon);
+  c->add_option("--reconstruct-coarse", a->reconstructCoarse,
+                fmt::format("Reconstruction cuts: cells of M pixels first, kept whole where their four corner samples "
+                            "lie on one surface and disagree about little of their light, else split down to N; M = N "
+                            "times a power of two, 0 = off; default {} = {}N",
+                            d.reconstructCoarse, kAutoCoarseFactor))
+      ->check(CLI::IsMember({"auto"}) | CLI::Range(0, 1 << 16))
+      ->group(recon);
   addSceneOptions(*c, a->load);
   c->callback([a] { exitStatus() = runRender(*a); });
 }

@@ -1,7 +1,12 @@
 #include "app/scene_options.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
+#include <initializer_list>
 #include <sstream>
+
+#include "io/scene_desc.h"
 
 namespace lc::app {
 
@@ -18,23 +23,53 @@ const CLI::Validator kLimitValue(
     },
     "INT>=0");
 
+// The name of `value` among `names` (the spelling the option takes), for the help's defaults.
+template <typename E>
+const char* nameOf(E value, std::initializer_list<std::pair<const char*, E>> names) {
+  for (const auto& [n, v] : names)
+    if (v == value) return n;
+  return "?";
+}
+
 }  // namespace
 
 void addSceneOptions(CLI::App& c, LoadOptions& o) {
-  c.add_flag("--lenient", o.lenient, "Skip unknown keywords in .ray files with a warning instead of failing");
+  // Defaults as the loader sees them: o's own values, and VplOptions' and LightDesc's for
+  // what o leaves unset (the scene's instant_radiosity block comes between).
+  const lights::VplOptions vpl;
+  const io::LightDesc light;
+  const char* kind = nameOf(o.objectLights.kind, {std::pair{"oriented", lights::ObjectLightKind::Oriented},
+                                                  std::pair{"omni", lights::ObjectLightKind::Omni}});
+  const char* placement = nameOf(o.objectLights.placement, {std::pair{"stratified", lights::Placement::Stratified},
+                                                            std::pair{"seed", lights::Placement::Seed}});
+  const char* normalize = nameOf(vpl.normalize, {std::pair{"power", lights::VplNormalize::Power},
+                                                 std::pair{"object", lights::VplNormalize::Object}});
+  const std::string lightsGroup = "Lights & GI";
+  const std::string limitsGroup = "Limits";
+
+  c.add_flag("--lenient", o.lenient,
+             fmt::format("Skip unknown keywords in .ray files with a warning instead of failing (default {})",
+                         o.lenient ? "on" : "off"))
+      ->group("Scene");
   c.add_option("--object-lights", [&o](const CLI::results_t& r) {
      o.objectLights.kind = lights::parseObjectLightKind(r[0]);
      return true;
-   }, "Lights of luminous objects: oriented (cosine emission about the surface normal, default) or omni (the seed's)")
-      ->check(CLI::IsMember({"oriented", "omni"}));
+   }, fmt::format("Lights of luminous objects: oriented (cosine emission about the surface normal) or omni (the "
+                  "seed's); default {}", kind))
+      ->check(CLI::IsMember({"oriented", "omni"}))
+      ->group(lightsGroup);
   c.add_option("--object-light-placement", [&o](const CLI::results_t& r) {
      o.objectLights.placement = lights::parsePlacement(r[0]);
      return true;
-   }, "Where object lights go: stratified (area-uniform low-discrepancy, default) or seed (the seed's pattern)")
-      ->check(CLI::IsMember({"stratified", "seed"}));
+   }, fmt::format("Where object lights go: stratified (area-uniform low-discrepancy) or seed (the seed's pattern); "
+                  "default {}", placement))
+      ->check(CLI::IsMember({"stratified", "seed"}))
+      ->group(lightsGroup);
   c.add_option_function<float>("--emission-density", [&o](const float& v) { o.emissionDensity = v; },
-                               "Point lights per unit of world area for `emission = (r,g,b)` object lights (default 1)")
-      ->check(CLI::Range(0.0f, 1e30f));
+                               fmt::format("Point lights per unit of world area for `emission = (r,g,b)` object "
+                                           "lights; default {}", o.emissionDensity))
+      ->check(CLI::Range(0.0f, 1e30f))
+      ->group(lightsGroup);
   c.add_option("--default-attenuation", [&o](const CLI::results_t& r) {
      std::array<float, 3> a{};
      std::string s = r[0];
@@ -47,38 +82,63 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
      if (in >> extra) return false;
      o.defaultAttenuation = a;
      return true;
-   }, "Attenuation A,B,C (constant, linear, quadratic; each >= 0) of point and spot lights that set none "
-      "(the UW renderer's sliders)")
-      ->type_name("A,B,C");
+   }, fmt::format("Attenuation A,B,C (constant, linear, quadratic; each >= 0) of point and spot lights that set "
+                  "none (the UW renderer's sliders); default {},{},{}",
+                  light.attenConstant, light.attenLinear, light.attenQuadratic))
+      ->type_name("A,B,C")
+      ->group(lightsGroup);
   c.add_option_function<int>("--vpls", [&o](const int& v) { o.vplCount = v; },
-                             "Instant radiosity: number of light paths shot for virtual point lights (overrides the scene)")
-      ->check(CLI::Range(0, 1 << 30));
-  c.add_option_function<int>("--bounces", [&o](const int& v) { o.bounces = v; }, "Instant radiosity: diffuse bounces (default 1)")
-      ->check(CLI::Range(0, 64));
+                             fmt::format("Instant radiosity: number of light paths shot for virtual point lights "
+                                         "(overrides the scene); default the scene's instant_radiosity vpls, else {}",
+                                         vpl.count))
+      ->check(CLI::Range(0, 1 << 30))
+      ->group(lightsGroup);
+  c.add_option_function<int>("--bounces", [&o](const int& v) { o.bounces = v; },
+                             fmt::format("Instant radiosity: diffuse bounces; default the scene's, else {}", vpl.bounces))
+      ->check(CLI::Range(0, 64))
+      ->group(lightsGroup);
   c.add_option_function<std::string>("--vpl-normalize", [&o](const std::string& v) { o.vplNormalize = v; },
-                                     "VPL intensities: power (energy conserving, default) or object (the seed's per-object division)")
-      ->check(CLI::IsMember({"power", "object"}));
+                                     fmt::format("VPL intensities: power (energy conserving) or object (the seed's "
+                                                 "per-object division); default the scene's, else {}", normalize))
+      ->check(CLI::IsMember({"power", "object"}))
+      ->group(lightsGroup);
   c.add_option_function<float>("--vpl-clamp", [&o](const float& v) { o.vplClamp = v; },
-                               "VPL distance clamp, as a fraction of half the scene diagonal (default 0.05)")
-      ->check(CLI::Range(0.0f, 1e6f));
+                               fmt::format("VPL distance clamp, as a fraction of half the scene diagonal; default the "
+                                           "scene's, else {}", vpl.clamp))
+      ->check(CLI::Range(0.0f, 1e6f))
+      ->group(lightsGroup);
   c.add_option_function<std::string>("--gi", [&o](const std::string& v) { o.gi = v == "on"; },
-                                     "Global illumination from VPLs: on (default) or off")
-      ->check(CLI::IsMember({"on", "off"}));
-  c.add_option("--max-lights", o.limits.maxLights, "Limit on lights (object lights, VPLs and scene lights)")
-      ->check(kLimitValue);
-  c.add_option("--max-vpls", o.limits.maxVpls, "Limit on VPLs")
-      ->check(kLimitValue);
+                                     fmt::format("Global illumination from VPLs: on or off; default {}", o.gi ? "on" : "off"))
+      ->check(CLI::IsMember({"on", "off"}))
+      ->group(lightsGroup);
+  c.add_option("--max-lights", o.limits.maxLights,
+               fmt::format("Limit on lights (object lights, VPLs and scene lights); default {}", o.limits.maxLights))
+      ->check(kLimitValue)
+      ->group(limitsGroup);
+  c.add_option("--max-vpls", o.limits.maxVpls, fmt::format("Limit on VPLs; default {}", o.limits.maxVpls))
+      ->check(kLimitValue)
+      ->group(limitsGroup);
   c.add_option_function<uint64_t>("--max-triangles", [&o](const uint64_t& v) { o.limits.maxTriangles = o.limits.maxVertices = v; },
-                                  "Limit on triangles (and vertices) in all meshes")
-      ->check(kLimitValue);
-  c.add_option("--max-nesting", o.limits.maxNesting, "Limit on nested transforms and groups in .ray files")
-      ->check(kLimitValue);
-  c.add_option("--max-objects", o.limits.maxObjects, "Limit on primitives and materials in a .ray file")
-      ->check(kLimitValue);
-  c.add_option("--max-image-pixels", o.limits.maxImagePixels, "Limit on width x height")
-      ->check(kLimitValue);
-  c.add_option("--max-texture-pixels", o.limits.maxTexturePixels, "Limit on the pixels of one texture")
-      ->check(kLimitValue);
+                                  fmt::format("Limit on triangles (and vertices) in all meshes; default {}",
+                                              o.limits.maxTriangles))
+      ->check(kLimitValue)
+      ->group(limitsGroup);
+  c.add_option("--max-nesting", o.limits.maxNesting,
+               fmt::format("Limit on nested transforms and groups in .ray files; default {}", o.limits.maxNesting))
+      ->check(kLimitValue)
+      ->group(limitsGroup);
+  c.add_option("--max-objects", o.limits.maxObjects,
+               fmt::format("Limit on primitives and materials in a .ray file; default {}", o.limits.maxObjects))
+      ->check(kLimitValue)
+      ->group(limitsGroup);
+  c.add_option("--max-image-pixels", o.limits.maxImagePixels,
+               fmt::format("Limit on width x height; default {}", o.limits.maxImagePixels))
+      ->check(kLimitValue)
+      ->group(limitsGroup);
+  c.add_option("--max-texture-pixels", o.limits.maxTexturePixels,
+               fmt::format("Limit on the pixels of one texture; default {}", o.limits.maxTexturePixels))
+      ->check(kLimitValue)
+      ->group(limitsGroup);
 }
 
 }  // namespace lc::app

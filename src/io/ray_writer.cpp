@@ -1,14 +1,16 @@
 // .ray writer. The output reads back (parseRayString) to the same camera, lights,
-// per-object materials, meshes and transforms: floats are printed with 9 significant
-// digits and matrices with 17, which round-trip exactly.
+// per-object materials, meshes and transforms: floats and matrix entries (doubles) are
+// printed in the shortest form that reads back to the same value (0.63, not 0.629999995).
 //
 // It never writes a top-level `material = ...`, so every inline material block starts
 // from the initial all-zero default and spells out all its fields. A named material is
 // declared inline at its first use and referred to by name afterwards.
 #include "io/ray_writer.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -64,17 +66,37 @@ class Writer {
 
  private:
   // ---- numbers --------------------------------------------------------------------------
+  // Floats in the shortest form that reads back as the same float (0.63f -> "0.63", not
+  // %.9g's "0.629999995"). The reader parses a double and narrows it to float, which can
+  // round differently from a direct decimal -> float conversion right at a tie, so each
+  // candidate is checked through that same path; 17 digits of the double always read back.
   void fnum(float v) {
     if (!std::isfinite(v)) throw Error("cannot write a non-finite number (" + std::to_string(v) + ") as .ray");
     char buf[40];
-    std::snprintf(buf, sizeof buf, "%.9g", double(v));
+    auto readsBack = [&](const char* end) {
+      double d = 0;
+      auto [p, ec] = std::from_chars(buf, end, d);
+      float f = float(d);
+      return ec == std::errc() && p == end && std::memcmp(&f, &v, sizeof f) == 0;
+    };
+    auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+    if (ec == std::errc() && readsBack(end)) {
+      out_.append(buf, end);
+      return;
+    }
+    for (const char* fmt : {"%.9g", "%.17g"}) {
+      int n = std::snprintf(buf, sizeof buf, fmt, double(v));
+      if (n > 0 && n < int(sizeof buf) && readsBack(buf + n)) break;
+    }
     out_ += buf;
   }
+  // Doubles (transform matrices) in the shortest form that reads back as the same double.
   void dnum(double v) {
     if (!std::isfinite(v)) throw Error("cannot write a non-finite number (" + std::to_string(v) + ") as .ray");
     char buf[40];
-    std::snprintf(buf, sizeof buf, "%.17g", v);
-    out_ += buf;
+    auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+    if (ec != std::errc()) throw Error("cannot write the number " + std::to_string(v) + " as .ray");
+    out_.append(buf, end);
   }
   void vec(const Vec3& v) {
     out_ += '(';
