@@ -126,6 +126,7 @@ int runRender(RenderArgs& a) {
   io::ToneMap tonemap = a.tonemap == "srgb" ? io::ToneMap::Srgb : io::ToneMap::Clamp;
 
   a.load.threads = a.threads;
+  a.load.objectLights.seed = a.seed;  // shifts the stratified object-light points
   // sRGB texture maps (from MTL files) are linearised only for a physically based output.
   a.load.linearizeSrgbTextures = tonemap == io::ToneMap::Srgb;
   a.load.quiet = a.quiet;
@@ -399,7 +400,7 @@ void addRenderCommand(CLI::App& app) {
     a->load.vplSeed = v;
   };
   c->add_option_function<uint64_t>("--seed", setSeed,
-                                   fmt::format("Random seed (sampling, representatives, VPL paths; overrides "
+                                   fmt::format("Random seed (sampling, representatives, VPL paths, object-light placement; overrides "
                                                "instant_radiosity's seed); default {}", d.seed))
       ->group(image);
   c->add_option("--method", a->method,

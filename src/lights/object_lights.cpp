@@ -51,6 +51,8 @@
 //            base-5 coordinate is below s(n)/s_max, where s(n) = |det M| |M^-T n| is the
 //            local-to-world area scale at local unit normal n: uniform in WORLD area under
 //            any affine M (non-uniform scale, shear).
+//            --seed S (S != 1) shifts all of these point sets toroidally by a hash of S
+//            (a Cranley-Patterson rotation): other positions, the same stratification.
 //   seed     the seed's pattern on triangles (quadrics use the stratified sampler): point 0
 //            at the centroid C; then k = max(1, round(sqrt((n_t - 1)/3))) points on each
 //            line from C to vertex j at fractions l/(k+1), l = 1..k (levels l outer loop,
@@ -124,6 +126,28 @@ void shiftedHammersley(uint64_t i, uint64_t n, double shift, double& x, double& 
   x = frac(shift + double(i) / double(n));
   y = frac(shift + radicalInverseD(2, i));
 }
+
+// A toroidal shift of every point set by --seed (Cranley-Patterson rotation): other seeds
+// place the lights elsewhere, still stratified; seed 1 (the default) shifts nothing, so the
+// default lights are those of earlier releases.
+struct SeedShift {
+  double x = 0, y = 0;
+  explicit SeedShift(uint64_t seed) {
+    if (seed == 1) return;
+    uint64_t h = seed * 0x9E3779B97F4A7C15ull;
+    h ^= h >> 31;
+    h *= 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 29;
+    x = double(h >> 11) * 0x1p-53;
+    h *= 0x94D049BB133111EBull;
+    h ^= h >> 32;
+    y = double(h >> 11) * 0x1p-53;
+  }
+  void apply(double& u, double& v) const {
+    u = frac(u + x);
+    v = frac(v + y);
+  }
+};
 
 // Heitz 2019, "A Low-Distortion Map Between Triangle and Square": area-preserving.
 // (2/3, 2/3) maps to the centroid.
@@ -500,6 +524,7 @@ void fillMesh(const scene::Scene& scene, const Emitter& e, const ObjectLightOpti
   const Shape& sh = scene.shapes()[size_t(e.shape)];
   const scene::Mesh& m = scene.meshes()[size_t(sh.mesh)];
   const double density = e.lum->density;
+  const SeedShift shift(o.seed);
   const size_t nt = m.triangles.size();
   // Prefix sums fix every triangle's first point index, so the parallel fill is deterministic.
   std::vector<uint64_t> first(nt + 1, 0);
@@ -530,6 +555,7 @@ void fillMesh(const scene::Scene& scene, const Emitter& e, const ObjectLightOpti
         for (uint64_t i = 0; i < n; ++i) {
           double x, y, b[3];
           shiftedHammersley(i, n, 2.0 / 3.0, x, y);
+          shift.apply(x, y);
           squareToTriangle(x, y, b);
           emit(b);
         }
@@ -541,6 +567,7 @@ void fillMesh(const scene::Scene& scene, const Emitter& e, const ObjectLightOpti
 
 void fillQuadric(const Shape& sh, const Emitter& e, const ObjectLightOptions& o, const Writer& w) {
   AreaScale s(sh);
+  const SeedShift shift(o.seed);
   uint64_t k = 0;
   auto emit = [&](const D3& local, const D3& nLocal, int part) {
     if ((k & 0xffff) == 0 && o.cancel && o.cancel->load(std::memory_order_relaxed)) throw Interrupted();
@@ -554,6 +581,7 @@ void fillQuadric(const Shape& sh, const Emitter& e, const ObjectLightOptions& o,
         for (uint64_t i = 0; i < p.count; ++i) {
           double x, y;
           shiftedHammersley(i, p.count, 0.5, x, y);
+          shift.apply(x, y);
           D3 q;
           for (int j = 0; j < 3; ++j) q[size_t(j)] = p.centre[size_t(j)] + (x - 0.5) * p.e1[size_t(j)] + (y - 0.5) * p.e2[size_t(j)];
           emit(q, p.normal, p.id);
@@ -563,6 +591,7 @@ void fillQuadric(const Shape& sh, const Emitter& e, const ObjectLightOptions& o,
         for (uint64_t i = 0; i < p.count; ++i) {
           double x, y, dx, dy;
           shiftedHammersley(i, p.count, 0.5, x, y);
+          shift.apply(x, y);
           squareToDisk(x, y, dx, dy);
           emit(D3{dx * p.radius, dy * p.radius, p.z0}, p.normal, p.id);
         }
@@ -576,6 +605,7 @@ void fillQuadric(const Shape& sh, const Emitter& e, const ObjectLightOptions& o,
           if (i > maxTries)
             throw Error(sh.loc, "internal: object light sampling did not converge (a degenerate transform?)");
           double u = radicalInverseD(2, i), v = radicalInverseD(3, i), r = radicalInverseD(5, i);
+          shift.apply(u, v);
           double phi = 2 * kPiD * v;
           D3 q, n;
           if (p.kind == PartKind::Sphere) {

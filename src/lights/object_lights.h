@@ -28,7 +28,7 @@ struct ObjectLightOptions {
   ObjectLightKind kind = ObjectLightKind::Oriented;
   Placement placement = Placement::Stratified;
   uint64_t maxLights = 20'000'000;  // --max-lights
-  uint64_t seed = 1;  // unused so far: placement is a deterministic function of the geometry
+  uint64_t seed = 1;  // --seed: shifts the stratified points (1: none); the seed pattern ignores it
   ProgressFn progress = {};  // called with the share of lights placed (core/progress.h)
   // When set and it becomes true, placement stops within a block of lights and
   // addObjectLights throws lc::Interrupted.

@@ -937,3 +937,51 @@ TEST(ObjectLights, CornellBoxFloorIsLitBelowThePanel) {
 
 }  // namespace
 }  // namespace lc::lights
+
+namespace lc::lights {
+namespace {
+
+// --seed shifts the stratified points (every kind of part): another seed places the lights
+// elsewhere on the same surfaces with the same count and power; the same seed, the same
+// lights; seed 1 is the default placement.
+TEST(ObjectLights, SeedShiftsTheStratifiedPoints) {
+  const std::string body =
+      lum(10, 40) +
+      "\ntrimesh { points = ((0,0,0), (1,0,0), (0,1,0)); faces = ((0,1,2)); }\n"
+      "translate(3, 0, 0, box {})\n"
+      "translate(6, 0, 0, cylinder {})\n"
+      "translate(9, 0, 0, sphere {})\n";
+  auto at = [&](uint64_t seed) {
+    ObjectLightOptions o;
+    o.seed = seed;
+    return build(body, o);
+  };
+  Built def = build(body), one = at(1), a = at(7), again = at(7), b = at(8);
+  ASSERT_EQ(def.lights().size(), a.lights().size());
+  ASSERT_EQ(a.lights().size(), b.lights().size());
+  ASSERT_GT(a.lights().size(), 100u);
+  size_t moved = 0, movedB = 0;
+  for (size_t i = 0; i < a.lights().size(); ++i) {
+    EXPECT_EQ(one.lights()[i].position, def.lights()[i].position) << i;
+    EXPECT_EQ(again.lights()[i].position, a.lights()[i].position) << i;
+    moved += !(a.lights()[i].position == def.lights()[i].position);
+    movedB += !(b.lights()[i].position == a.lights()[i].position);
+  }
+  EXPECT_GT(moved, a.lights().size() * 9 / 10);
+  EXPECT_GT(movedB, a.lights().size() * 9 / 10);
+  for (size_t k = 0; k < a.info.size(); ++k) {
+    EXPECT_EQ(a.info[k].lights, def.info[k].lights);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a.info[k].power[c], def.info[k].power[c], 1e-4 * def.info[k].power[c]);
+  }
+  // Still on the surfaces: the triangle's lights lie in it (z = 0, x, y >= 0, x + y <= 1).
+  for (size_t i = 0; i < a.info[0].lights; ++i) {
+    const Vec3& p = a.lights()[i].position;
+    EXPECT_NEAR(p.z, 0, 1e-6);
+    EXPECT_GE(p.x, -1e-6);
+    EXPECT_GE(p.y, -1e-6);
+    EXPECT_LE(p.x + p.y, 1 + 1e-5);
+  }
+}
+
+}  // namespace
+}  // namespace lc::lights
