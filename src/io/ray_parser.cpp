@@ -1334,11 +1334,15 @@ void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
 }
 
 // obj_mesh { file = "model.obj" (required, relative to the .ray file);
-//            material = ... (overrides the MTL materials); name = ...; }
+//            material = ... (overrides the MTL materials); name = ...;
+//            emission = (r,g,b) (COMP4411: the mesh takes a copy of its material, the given
+//            one or else the current default, with emission applied; overrides the MTL) }
 // The OBJ's MTL materials start from the current default material.
 void Parser::objMesh(const Token& kw, ObjectDesc& obj) {
   std::string file;
   std::optional<int> material;
+  std::optional<Color> emission;
+  Token emissionTok;
   block("obj_mesh", [&](const Token& k) {
     const std::string& a = k.word;
     if (a == "file") {
@@ -1350,6 +1354,10 @@ void Parser::objMesh(const Token& kw, ObjectDesc& obj) {
     } else if (a == "material") {
       expectEquals();
       material = materialValue(defaultMat_);
+    } else if (a == "emission") {
+      expectEquals();
+      emissionTok = k;
+      emission = emissionValue();
     } else if (a == "name") {
       obj.name = nameValue().text;
     } else {
@@ -1358,6 +1366,7 @@ void Parser::objMesh(const Token& kw, ObjectDesc& obj) {
     return true;
   });
   if (file.empty()) fail(kw, "obj_mesh needs a file");
+  if (emission) material = emissiveCopy(material ? *material : defaultMat_, *emission, emissionTok);
   Limits remaining = opt_.limits;
   remaining.maxTriangles -= std::min(remaining.maxTriangles, totalTriangles_);
   remaining.maxVertices -= std::min(remaining.maxVertices, totalVertices_);

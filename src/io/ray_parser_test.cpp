@@ -907,6 +907,28 @@ TEST(RayParserObjMesh, LoadsARealObjWhenTheLoaderIsAvailable) {
   expectVec(materialOf(s, 1).diffuse.value, 0.25f, 0.5f, 1);
 }
 
+// `emission` on an obj_mesh (COMP4411): one emissive copy of its material for the whole mesh.
+TEST(RayParserObjMesh, EmissionMakesTheMeshALight) {
+  std::string dir = lc::testing::dataPath("models");
+  std::string text = std::string(kHeader) +
+                     "obj_mesh { file = \"cube.obj\"; emission = (1, 2, 3); }\n"
+                     "obj_mesh { file = \"cube.obj\"; material = { diffuse = (0.25, 0.5, 1); }; emission = (4, 4, 4); }\n";
+  SceneDesc s = parseRayString(text, "t.ray", dir, {});
+  ASSERT_EQ(s.objects.size(), 2u);
+  for (int i = 0; i < 2; ++i) EXPECT_TRUE(s.meshes[size_t(i)].triangleMaterials.empty()) << i;
+  const MaterialDesc& a = materialOf(s, 0);
+  ASSERT_TRUE(a.luminosity);
+  EXPECT_TRUE(a.luminosity->perArea);
+  expectVec(a.emissive.value, 1, 2, 3);
+  const MaterialDesc& b = materialOf(s, 1);
+  ASSERT_TRUE(b.luminosity);
+  expectVec(b.emissive.value, 4, 4, 4);
+  expectVec(b.diffuse.value, 0.25f, 0.5f, 1);
+  EXPECT_EQ(error("obj_mesh { file = \"x.obj\"; emission = (-1, 0, 0); }").find("emission components must be finite and >= 0") !=
+                std::string::npos,
+            true);
+}
+
 TEST(RayParserObjMesh, MergeOffsetsTriangleMaterials) {
   SceneDesc s;
   s.materials.resize(3);
