@@ -242,6 +242,9 @@ std::vector<Row> catalogue() {
           "index_too_large.ray:2:55: error: index must be at most 1000, got 1e20"),
       ray("value_out_of_range", "camera { fov = 200; }",
           "value_out_of_range.ray:2:16: error: fov must be between 0 and 180 degrees, got 200"),
+      ray("fov_rounds_to_180", "camera { fov = 179.99999999; }",
+          "fov_rounds_to_180.ray:2:16: error: fov must be between 0 and 180 degrees, got 180 "
+          "(179.99999999 rounds to 180 in single precision)"),
       ray("negative_attenuation", "point_light { constant_attenuation_coeff = -1; }",
           "negative_attenuation.ray:2:44: error: constant_attenuation_coeff must be >= 0, got -1"),
       ray("negative_density", "sphere { material = { luminosity = { density = -1; }; }; }",

@@ -61,6 +61,27 @@ inline Vec3 normalize(const Vec3& v) {
   float l = length(v);
   return l > 0 ? v / l : v;
 }
+// normalize() for vectors whose squared length overflows or underflows a float (a
+// direction of (1e20,1e20,-1e20) or (1e-30,0,0)): divides by the largest component
+// first. Scene setup only (it costs a few more operations than normalize). A zero or
+// non-finite vector comes back unchanged.
+inline Vec3 normalizeScaled(const Vec3& v) {
+  float m = std::max(std::fabs(v.x), std::max(std::fabs(v.y), std::fabs(v.z)));
+  if (!(m > 0) || !std::isfinite(m)) return v;
+  Vec3 s = v / m;
+  return s / std::sqrt(dot(s, s));
+}
+// length() that neither overflows nor underflows in the squared length (components near
+// 1e20 or 1e-20): scales by the largest component when the plain square is out of range.
+inline float lengthScaled(const Vec3& v) {
+  float l2 = dot(v, v);
+  if (l2 >= std::numeric_limits<float>::min() && l2 <= std::numeric_limits<float>::max())
+    return std::sqrt(l2);
+  float m = std::max(std::fabs(v.x), std::max(std::fabs(v.y), std::fabs(v.z)));
+  if (!(m > 0) || !std::isfinite(m)) return m;
+  Vec3 s = v / m;
+  return m * std::sqrt(dot(s, s));
+}
 constexpr Vec3 vmin(const Vec3& a, const Vec3& b) {
   return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
 }
@@ -139,7 +160,7 @@ struct Bounds3 {
   constexpr void extend(const Bounds3& b) { lo = vmin(lo, b.lo); hi = vmax(hi, b.hi); }
   constexpr Vec3 center() const { return (lo + hi) * 0.5f; }
   constexpr Vec3 extent() const { return hi - lo; }
-  inline float diagonal() const { return empty() ? 0.0f : length(hi - lo); }
+  inline float diagonal() const { return empty() ? 0.0f : lengthScaled(hi - lo); }
   constexpr float diagonal2() const { return empty() ? 0.0f : length2(hi - lo); }
   // Squared distance from p to the closest point of the box (0 inside).
   constexpr float distance2(const Vec3& p) const {

@@ -627,6 +627,29 @@ Image readImage(const std::string& path, bool srgb, uint64_t maxPixels) {
     if (readPnm16(path, readAll(f.get()), srgb, maxPixels, img)) return img;
   }
 
+  // A PNG's size comes from its IHDR, read here: stb refuses sizes over 2^24 with a reason
+  // that stbi_info loses ("unknown image type"), and the limit is the one to report.
+  if (got == 4 && magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G') {
+    unsigned char head[24];
+    if (std::fread(head, 1, sizeof head, f.get()) == sizeof head &&
+        std::memcmp(head + 12, "IHDR", 4) == 0) {
+      auto be32 = [&](int at) {
+        return uint32_t(head[at]) << 24 | uint32_t(head[at + 1]) << 16 | uint32_t(head[at + 2]) << 8 |
+               uint32_t(head[at + 3]);
+      };
+      uint32_t pw = be32(16), ph = be32(20);
+      // The PNG specification caps both at 2^31 - 1; larger is a corrupt header.
+      const uint32_t kMaxInt = uint32_t(std::numeric_limits<int>::max());
+      if (pw > kMaxInt || ph > kMaxInt) throwDecode(path, "corrupt PNG (bad IHDR size)");
+      checkSize(path, int(pw), int(ph), maxPixels);
+      // stb_image's own cap (STBI_MAX_DIMENSIONS, 2^24 per side by default).
+      if (pw > (1u << 24) || ph > (1u << 24))
+        throwDecode(path, std::to_string(pw) + "x" + std::to_string(ph) +
+                              " PNG is wider or taller than the decoder's 16777216 pixels");
+    }
+    std::rewind(f.get());
+  }
+
   int w = 0, h = 0, comp = 0;
   if (!stbi_info_from_file(f.get(), &w, &h, &comp)) throwDecode(path, stbiReason());
   // stbi_info reports a top-down BMP's height as negative (as stored); the decoder flips it.

@@ -289,6 +289,41 @@ TEST(Image, SizeLimitCheckedBeforeDecoding) {
   }
 }
 
+TEST(Image, HugePngHeaderIsReportedAgainstTheLimit) {
+  // Issue 23 #10: a PNG claiming (2^31-1)^2 pixels said "unknown image type" (stb refuses
+  // over 2^24 per side and stbi_info loses the reason). Only the header is needed.
+  TempDir dir;
+  std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A,  // signature
+                              0, 0, 0, 13, 'I', 'H', 'D', 'R',              // chunk length, type
+                              0x7F, 0xFF, 0xFF, 0xFF, 0x7F, 0xFF, 0xFF, 0xFF,  // width, height
+                              8, 2, 0, 0, 0, 0, 0, 0, 0};                  // depth, RGB, ..., CRC
+  writeRaw(dir.file("huge.png"), png);
+  try {
+    readImage(dir.file("huge.png"), false, 1000);
+    FAIL() << "expected an error";
+  } catch (const ImageReadError& e) {
+    EXPECT_EQ(e.kind, ImageReadError::Kind::TooLarge) << e.what();
+    EXPECT_EQ(e.width, 2147483647);
+    EXPECT_EQ(e.height, 2147483647);
+    EXPECT_NE(std::string(e.what()).find("2147483647x2147483647 = 4611686014132420609 pixels, more than "
+                                         "the limit of 1000"),
+              std::string::npos)
+        << e.what();
+  }
+  // Within the pixel limit but over stb's 2^24 per side: said so, not "unknown image type".
+  png[16] = 0x02, png[17] = 0, png[18] = 0, png[19] = 0;  // width 2^25
+  png[20] = 0, png[21] = 0, png[22] = 0, png[23] = 1;     // height 1
+  writeRaw(dir.file("wide.png"), png);
+  try {
+    readImage(dir.file("wide.png"), false, uint64_t(1) << 40);
+    FAIL() << "expected an error";
+  } catch (const ImageReadError& e) {
+    EXPECT_EQ(e.kind, ImageReadError::Kind::Decode) << e.what();
+    EXPECT_NE(std::string(e.what()).find("33554432x1 PNG is wider or taller than"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(Image, Bmp24BottomUpWithRowPadding) {
   TempDir dir;
   std::vector<uint8_t> bmp = makeBmp(3, 2, 24, k3x2);

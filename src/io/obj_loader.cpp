@@ -420,8 +420,13 @@ class MtlReader : public tinyobj::MaterialReader {
       add(slashed);
       add(fs::path(slashed).filename().string());
     }
+    std::string directory;  // a candidate that exists but is a directory
     for (const std::string& p : candidates) {
-      if (!isRegularFile(p)) continue;
+      if (!isRegularFile(p)) {
+        std::error_code dec;
+        if (directory.empty() && fs::is_directory(p, dec)) directory = p;
+        continue;
+      }
       std::error_code ec;
       uintmax_t size = fs::file_size(p, ec);
       if (!ec && size > limits_.maxFileBytes) {
@@ -442,6 +447,13 @@ class MtlReader : public tinyobj::MaterialReader {
       files.push_back(std::move(file));
       // tinyobj's MTL warnings are about d/Tr precedence, which we document instead.
       return true;
+    }
+    if (!directory.empty()) {
+      missing.push_back(objPath_ + ": warning: material library " + quoteInput(matId) +
+                        " is a directory (" + quoteInput(directory) +
+                        "), not a file; using default materials");
+      (void)warn;
+      return false;
     }
     std::string msg = objPath_ + ": warning: material library " + quoteInput(matId) + " not found (looked for";
     for (size_t i = 0; i < candidates.size(); ++i) msg += (i ? ", '" : " '") + candidates[i] + "'";
@@ -808,7 +820,7 @@ std::vector<LightDesc> defaultLights(const CameraDesc& cam, const Bounds3& bound
   Vec3 up = cam.upDir;
   Vec3 right = normalize(cross(cam.viewDir, up));
   Vec3 back = -cam.viewDir;
-  float dist = length(cam.position - c);
+  float dist = lengthScaled(cam.position - c);  // (a model near 1e30 overflows length())
   LightDesc key;
   key.position = cam.position + (up + right) * (0.5f * r);
   key.colour = Color(0.8f, 0.8f, 0.8f);
@@ -824,6 +836,38 @@ std::vector<LightDesc> defaultLights(const CameraDesc& cam, const Bounds3& bound
     l.loc = SourceLoc{path, 0, 0};
   }
   return lights;
+}
+
+// When the default camera or lights overflow a float (vertices near +-1e38): an error at
+// the `v` line with the largest coordinate, the vertex that put them out of range.
+void checkDefaultsFinite(const SceneDesc& s, const std::string& path) {
+  bool finite = isFinite(s.camera.position);
+  for (const LightDesc& l : s.lights) finite = finite && isFinite(l.position);
+  if (finite) return;
+  std::string text = readFile(path);
+  float largest = -1;
+  int largestLine = 0;
+  std::string coords;
+  forEachLine(text, [&](int lineNo, std::string_view raw) {
+    std::string_view line = trimLeft(raw);
+    if (!startsWithKeyword(line, "v")) return;
+    std::string_view rest = line.substr(2);
+    std::string here;
+    float m = 0;
+    for (int i = 0; i < 3; ++i) {
+      std::string_view tok = nextToken(rest);
+      if (tok.empty()) break;
+      here += (i ? ", " : "") + std::string(tok);
+      if (std::optional<float> v = tokenAsFloat(tok)) m = std::max(m, std::fabs(*v));
+    }
+    if (m > largest) largest = m, largestLine = lineNo, coords = here;
+  });
+  std::string msg = "the default camera and lights for this model are out of range for a float";
+  if (largestLine > 0)
+    throw Error(SourceLoc{path, largestLine, 0},
+                "vertex (" + coords + ") is too far from the origin: " + msg +
+                    " (scale the model down)");
+  throw Error(SourceLoc{path, 0, 0}, msg);
 }
 
 std::string describe(const SceneDesc& s, int luminousMaterials) {
@@ -879,6 +923,7 @@ SceneDesc loadObjScene(const std::string& path, const Limits& limits, std::strin
   s.camera = defaultCamera(s.meshes[0], obj.bounds, path);
   s.hasCamera = true;
   if (luminous == 0) s.lights = defaultLights(s.camera, obj.bounds, path);
+  checkDefaultsFinite(s, path);
   if (description) *description = describe(s, luminous);
   return s;
 }

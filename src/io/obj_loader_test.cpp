@@ -89,6 +89,17 @@ TEST(ObjLoader, MissingMaterialLibraryIsAWarning) {
   EXPECT_EQ(d.mesh.triangleMaterials, std::vector<int>{0});
 }
 
+TEST(ObjLoader, MaterialLibraryThatIsADirectoryIsNamedSo) {
+  // Issue 23 #10: it said "not found".
+  TempDir dir;
+  std::filesystem::create_directories(dir.file("lib.mtl"));
+  writeText(dir.file("m.obj"), "mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  ObjData d = load(dir.file("m.obj"));
+  EXPECT_TRUE(hasWarning(d.warnings, "material library 'lib.mtl' is a directory"));
+  EXPECT_FALSE(hasWarning(d.warnings, "not found"));
+  EXPECT_EQ(d.mesh.triangles.size(), 1u);
+}
+
 TEST(ObjLoader, MaterialLibraryFallsBackToTheFileBesideTheObj) {
   ObjData d = load(dataPath("obj/fallback/model.obj"));
   EXPECT_TRUE(d.warnings.empty()) << d.warnings.front();
@@ -499,6 +510,20 @@ TEST(ObjScene, DefaultCameraAndLightRig) {
        p = description.find("point_light {", p + 1))
     ++lights;
   EXPECT_EQ(lights, 2u);
+}
+
+TEST(ObjScene, VerticesTooLargeForTheDefaultCameraNameTheirLine) {
+  // Issue 23 #10: said "light parameters must be finite", with no file or line.
+  TempDir dir;
+  writeText(dir.file("huge.obj"), "v -1e38 -1e38 -1e38\nv 1 0 0\n# c\nv 1e38 1e38 2e38\nf 1 2 3\n");
+  std::string msg = errorOf([&] { loadObjScene(dir.file("huge.obj"), Limits{}, nullptr); });
+  EXPECT_NE(msg.find("huge.obj:4: error: vertex (1e38, 1e38, 2e38) is too far from the origin: the "
+                     "default camera and lights for this model are out of range for a float"),
+            std::string::npos)
+      << msg;
+  // Large but framable: loads.
+  writeText(dir.file("big.obj"), "v -1e30 0 0\nv 1e30 0 0\nv 0 1e30 0\nf 1 2 3\n");
+  EXPECT_NO_THROW(loadObjScene(dir.file("big.obj"), Limits{}, nullptr));
 }
 
 TEST(ObjScene, LuminousMaterialsReplaceTheLightRig) {

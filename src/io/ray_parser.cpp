@@ -648,11 +648,11 @@ void Parser::camera(const Token& kw) {
       c.position = coord();
     } else if (w == "viewdir") {
       c.viewDir = coord(&viewTok);
-      if (length2(c.viewDir) == 0) fail(viewTok, "viewdir must not be zero");
+      if (c.viewDir == Vec3(0, 0, 0)) fail(viewTok, "viewdir must not be zero");
       haveLookAt = false;
     } else if (w == "updir") {
       c.upDir = coord(&upTok);
-      if (length2(c.upDir) == 0) fail(upTok, "updir must not be zero");
+      if (c.upDir == Vec3(0, 0, 0)) fail(upTok, "updir must not be zero");
     } else if (w == "look_at") {
       lookAt = coord(&lookTok);
       haveLookAt = true;
@@ -673,7 +673,16 @@ void Parser::camera(const Token& kw) {
     } else if (w == "fov") {
       Token t = numberToken();
       float f = toFloat(t);
-      if (!(f > 0 && f < 180)) fail(t, "fov must be between 0 and 180 degrees, got " + t.text);
+      if (!(f > 0 && f < 180)) {
+        // Say so when the text is in range but its float is not (179.99999999 is 180.0f).
+        std::string got = t.text;
+        if (double(f) != t.number) {
+          char buf[32];
+          std::string fs(buf, std::to_chars(buf, buf + sizeof buf, f).ptr);
+          got = fs + " (" + t.text + " rounds to " + fs + " in single precision)";
+        }
+        fail(t, "fov must be between 0 and 180 degrees, got " + got);
+      }
       c.fovDegrees = f;
     } else if (w == "aspectratio") {
       c.aspectRatio = nonNegative("aspectratio", true);
@@ -684,10 +693,11 @@ void Parser::camera(const Token& kw) {
   });
   if (haveLookAt) {
     c.viewDir = lookAt - c.position;
-    if (length2(c.viewDir) == 0) fail(lookTok, "look_at must differ from the camera position");
+    if (c.viewDir == Vec3(0, 0, 0)) fail(lookTok, "look_at must differ from the camera position");
     viewTok = lookTok;
   }
-  Vec3 v = normalize(c.viewDir), u = normalize(c.upDir);
+  // normalizeScaled: the squared length of (1e-30,0,0) underflows a float.
+  Vec3 v = normalizeScaled(c.viewDir), u = normalizeScaled(c.upDir);
   if (!(length(cross(v, u)) > 1e-6f)) {
     const Token& at = (upTok.line > viewTok.line ||
                        (upTok.line == viewTok.line && upTok.column > viewTok.column))
@@ -756,7 +766,7 @@ void Parser::light(const Token& kw) {
       expectEquals();
       Token open;
       l.direction = coord(&open);
-      if (length2(l.direction) == 0) fail(open, "direction must not be zero");
+      if (l.direction == Vec3(0, 0, 0)) fail(open, "direction must not be zero");
       haveTarget = false;
     } else if (w == "target" && spot) {
       expectEquals();

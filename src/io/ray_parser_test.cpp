@@ -268,9 +268,31 @@ TEST(RayParserCamera, InvalidDirections) {
   EXPECT_EQ(error("camera { viewdir = (0,1,0); }"), "t.ray:2:20: error: viewdir and updir are parallel");
 }
 
+TEST(RayParserCamera, HugeAndTinyDirectionsAreNotParallelOrZero) {
+  // Issue 23 #10: (0,0,-1e20) said "parallel" (its squared length overflowed); now the
+  // coordinate limit names the real problem, and what passes it normalises safely.
+  EXPECT_EQ(error("camera { viewdir = (0,0,-1e20); }"),
+            "t.ray:2:25: error: number -1e20 is too large for a coordinate (at most 1e15 in magnitude)");
+  SceneDesc a = parse("camera { viewdir = (0,0,-1e15); updir = (0,1e15,1e15); }");
+  expectVec(a.camera.viewDir, 0, 0, -1e15f);
+  // Tiny components underflow the squared length: not zero, not parallel.
+  SceneDesc b = parse("camera { viewdir = (1e-30,0,0); updir = (0,1e-30,0); }");
+  expectVec(b.camera.viewDir, 1e-30f, 0, 0);
+  SceneDesc c = parse("directional_light { direction = (1e-30,0,-1e-30); }");
+  ASSERT_EQ(c.lights.size(), 1u);
+}
+
 TEST(RayParserCamera, InvalidFovAndAspect) {
   EXPECT_EQ(error("camera { fov = 180; }"), "t.ray:2:16: error: fov must be between 0 and 180 degrees, got 180");
   EXPECT_EQ(error("camera { fov = -5; }"), "t.ray:2:16: error: fov must be between 0 and 180 degrees, got -5");
+  // Issue 23 #10: in range as written, 180 as a float; the message says both.
+  EXPECT_EQ(error("camera { fov = 179.99999999; }"),
+            "t.ray:2:16: error: fov must be between 0 and 180 degrees, got 180 (179.99999999 rounds to "
+            "180 in single precision)");
+  EXPECT_EQ(error("camera { fov = 1e-50; }"),
+            "t.ray:2:16: error: fov must be between 0 and 180 degrees, got 0 (1e-50 rounds to 0 in "
+            "single precision)");
+  EXPECT_FLOAT_EQ(parse("camera { fov = 179.9999; }").camera.fovDegrees, 179.9999f);
   EXPECT_EQ(error("camera { aspectratio = 0; }"), "t.ray:2:24: error: aspectratio must be > 0, got 0");
 }
 

@@ -239,12 +239,12 @@ std::unique_ptr<Scene> Scene::build(const io::SceneDesc& desc, const BuildOption
         break;
       case io::LightKind::Directional:
         l.type = LightType::Directional;
-        l.direction = normalize(ld.direction);
+        l.direction = normalizeScaled(ld.direction);
         g.atten = Attenuation{0, 0, 0, kInf};
         break;
       case io::LightKind::Spot: {
         l.type = LightType::Spot;
-        l.direction = normalize(ld.direction);
+        l.direction = normalizeScaled(ld.direction);
         g.falloff.exponent = ld.exponent;
         g.falloff.cosCutoff = std::cos(std::clamp(ld.cutoffDegrees, 0.0f, 180.0f) * kPi / 180);
         if (ld.cutoffDegrees >= 180) g.falloff.cosCutoff = -1.0f - 1e-6f;

@@ -213,5 +213,35 @@ TEST(Camera, CentreRayLooksAlongViewDirection) {
   EXPECT_NEAR(std::fabs(right.x / right.z), 2, 1e-5);
 }
 
+TEST(Camera, HugeViewAndUpDirectionsAreNormalisedSafely) {
+  // Issue 23 #10: the squared length of (0,0,-1e20) overflows a float.
+  io::CameraDesc c;
+  c.viewDir = Vec3(0, 0, -1e20f);
+  c.upDir = Vec3(0, 1e30f, 0);
+  c.fovDegrees = 90;
+  Camera cam = Camera::fromDesc(c, 1.0f);
+  expectVec(normalize(cam.direction(0.5f, 0.5f)), Vec3(0, 0, -1));
+  expectVec(cam.up, Vec3(0, 1, 0));
+  expectVec(cam.right, Vec3(1, 0, 0));
+}
+
+TEST(Scene, HugeDirectionalLightDirectionIsNormalised) {
+  // Issue 23 #10: (1e20,1e20,-1e20) normalised to zero and the scene rendered black.
+  io::SceneDesc d;
+  d.materials.emplace_back();
+  for (Vec3 dir : {Vec3(1e20f, 1e20f, -1e20f), Vec3(1e-30f, 1e-30f, -1e-30f)}) {
+    for (io::LightKind kind : {io::LightKind::Directional, io::LightKind::Spot}) {
+      io::LightDesc l;
+      l.kind = kind;
+      l.direction = dir;
+      d.lights = {l};
+      auto s = Scene::build(d);
+      ASSERT_EQ(s->lights().lights.size(), 1u);
+      float k = 1 / std::sqrt(3.0f);
+      expectVec(s->lights().lights[0].direction, Vec3(k, k, -k), 1e-5f);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace lc::scene
