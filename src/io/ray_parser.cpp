@@ -880,6 +880,13 @@ void Parser::areaLight(const Token& kw) {
   lum.colour = ColorParam{colour, std::nullopt};
   lum.intensity = 1;
   lum.loc = lex_.loc(kw);
+  // The course renderers took the attenuation from their UI for every light: an area light
+  // sets no coefficients, so --default-attenuation (the sliders) applies to it too.
+  if (opt_.defaultAttenuation) {
+    lum.attenConstant = (*opt_.defaultAttenuation)[0];
+    lum.attenLinear = (*opt_.defaultAttenuation)[1];
+    lum.attenQuadratic = (*opt_.defaultAttenuation)[2];
+  }
   m.luminosity = lum;
   m.loc = lex_.loc(kw);
 

@@ -1462,5 +1462,23 @@ TEST(RayParserLights, DefaultAttenuation) {
   EXPECT_EQ(s.lights[1].attenQuadratic, 1);
 }
 
+// An area_light has no coefficients of its own: --default-attenuation reaches it (the
+// COMP4411 soft-shadow sample), and without the option it keeps 1/d^2.
+TEST(RayParserLights, DefaultAttenuationReachesAreaLights) {
+  const std::string body = "area_light { u = (1, 0, 0); v = (0, 1, 0); }\n";
+  SceneDesc plain = parse(body);
+  ASSERT_EQ(plain.objects.size(), 1u);
+  const LuminosityDesc& p = *plain.materials[size_t(plain.objects[0].material)].luminosity;
+  EXPECT_EQ(p.attenConstant, 0);
+  EXPECT_EQ(p.attenQuadratic, 1);
+  ParseOptions o;
+  o.defaultAttenuation = std::array<float, 3>{1, 0.5f, 0};
+  SceneDesc s = parse(body, o);
+  const LuminosityDesc& l = *s.materials[size_t(s.objects[0].material)].luminosity;
+  EXPECT_EQ(l.attenConstant, 1);
+  EXPECT_EQ(l.attenLinear, 0.5f);
+  EXPECT_EQ(l.attenQuadratic, 0);
+}
+
 }  // namespace
 }  // namespace lc::io
