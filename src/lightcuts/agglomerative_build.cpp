@@ -39,10 +39,6 @@ using detail::Cluster;
 
 // The clusters of one build by id: leaves (0..n-1) made from their lights when asked, so
 // that only the n - 1 merges (n..2n-2) take memory (88 bytes each).
-inline double lightLuminance(const Color& c) {
-  return 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z);
-}
-
 struct ClusterStore {
   const LightSet& lights;
   const std::vector<uint32_t>& indices;
@@ -55,7 +51,7 @@ struct ClusterStore {
     if (i >= leaves()) return merged[i - leaves()];
     const Light& l = lights.lights[indices[i]];
     Cluster c = detail::leafCluster(l, indices[i]);
-    c.weight = float(lightLuminance(l.intensity) * weightScale);
+    c.weight = float(luminance(Vec3d(l.intensity)) * weightScale);
     return c;
   }
   Cluster& mergedAt(int32_t id) { return merged[size_t(id) - leaves()]; }
@@ -734,7 +730,7 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   // NaN from inf * 0) metrics, and the nearest-neighbour search never found a partner.
   {
     double maxLum = 0;
-    for (size_t i = 0; i < n; ++i) maxLum = std::max(maxLum, lightLuminance(lights.lights[indices[i]].intensity));
+    for (size_t i = 0; i < n; ++i) maxLum = std::max(maxLum, luminance(Vec3d(lights.lights[indices[i]].intensity)));
     clusters.weightScale = maxLum > 0 && std::isfinite(maxLum) ? 1 / maxLum : 1.0;
   }
   if (n == 1) {

@@ -88,7 +88,8 @@ struct GroupKey {
   }
 };
 
-double lum(const Color& c) { return 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z); }
+// Luminance in double: luminances near FLT_MAX would overflow a float sum.
+double lum(const Color& c) { return luminance(Vec3d(c)); }
 
 }  // namespace
 

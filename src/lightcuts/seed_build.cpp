@@ -88,7 +88,7 @@ struct SeedBuilder {
   float nodeError(size_t b, size_t e) const {
     // In double: luminances of huge lights would overflow float sums.
     double w = 0, cx = 0, cy = 0, cz = 0, sr = 0, sg = 0, sb = 0;
-    auto lum = [](const Color& c) { return 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z); };
+    auto lum = [](const Color& c) { return luminance(Vec3d(c)); };
     for (size_t i = b; i < e; ++i) {
       const Light& l = lights.lights[idx[i]];
       double li = lum(l.intensity);
