@@ -845,6 +845,53 @@ TEST(CliLimitsRender, VplsFromTheCommandLine) {
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
 
+// --max-memory: one budget over items, meshes, lights and the image, counted before they
+// are allocated (core/memory_budget.h). Each case fails at a budget just under its need and
+// passes just above it.
+TEST(CliLimitsMemory, EachConsumerIsCountedAgainstOneBudget) {
+  TempDir dir;
+  fs::copy_file(lc::testing::dataPath("models/cube.obj"), dir.file("cube.obj"));
+  writeText(dir.file("items.ray"), kHeader + "sphere {} sphere {} sphere {} sphere {}\n");
+  writeText(dir.file("obj.ray"), kHeader + "obj_mesh { file = \"cube.obj\"; }\n");
+  writeText(dir.file("lum.ray"),
+            kHeader + "square { material = { luminosity = { density = 1000; intensity = 1; }; }; }\n");
+  writeText(dir.file("vpl.ray"), kHeader + "point_light { position = (0,0,2); }\nsphere {}\n");
+  struct Case {
+    std::vector<std::string> args;
+    std::string tight, loose, message;
+  };
+  const Case cases[] = {
+      {{"info", "items.ray"}, "4K", "8K",
+       "items.ray:2:31: error: 5 objects and materials need about 6.2 KB, more than --max-memory (4.0 KB)"},
+      {{"info", "obj.ray"}, "4K", "8K",
+       "obj.ray:2:1: error: the 12 triangles of OBJ file 'cube.obj' need about 3.5 KB (4.8 KB with what is "
+       "already loaded), more than --max-memory (4.0 KB)"},
+      {{"info", "lum.ray"}, "600K", "800K",
+       "lum.ray:2:23: error: the 2000 lights of luminous objects need about 625.0 KB, more than --max-memory "
+       "(600.0 KB)"},
+      {{"info", "vpl.ray", "--vpls", "1000"}, "300K", "400K",
+       "1000 VPLs need about 312.5 KB, more than --max-memory (300.0 KB)"},
+      {{"render", "vpl.ray", "-o", "i.png", "-q", "--width", "100", "--height", "100"}, "300K", "400K",
+       "the 100x100 image's buffers need about 312.5 KB, more than --max-memory (300.0 KB)"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args[1]);
+    std::vector<std::string> args = c.args;
+    args.insert(args.end(), {"--max-memory", c.tight});
+    CliResult bad = run(args, dir.path());
+    EXPECT_EQ(bad.status, 1);
+    EXPECT_EQ(bad.err, "lightcuts: " + c.message + "\n");
+    EXPECT_FALSE(fs::exists(dir.file("i.png")));
+    args.back() = c.loose;
+    CliResult ok = run(args, dir.path());
+    EXPECT_EQ(ok.status, 0) << ok.err;
+  }
+  CliResult junk = run({"info", "items.ray", "--max-memory", "1.5.0"}, dir.path());
+  EXPECT_EQ(junk.status, 105);
+  EXPECT_NE(junk.err.find("a memory size must be bytes >= 0, or with K/M/G/T (8G), got 1.5.0"), std::string::npos)
+      << junk.err;
+}
+
 // ---------------------------------------------------------------------------------------
 // Interruption and output safety
 

@@ -16,6 +16,7 @@
 #include "app/scene_options.h"
 #include "app/summary.h"
 #include "core/file_util.h"
+#include "core/memory_budget.h"
 #include "io/colormap.h"
 #include "io/image.h"
 #include "lightcuts/evaluator.h"
@@ -164,6 +165,8 @@ int runRender(RenderArgs& a) {
   if (uint64_t(a.width) * uint64_t(a.height) > a.load.limits.maxImagePixels)
     throw Error(fmt::format("an image of {}x{} exceeds --max-image-pixels ({})", a.width, a.height,
                             a.load.limits.maxImagePixels));
+  processBudget().reserve(uint64_t(a.width) * uint64_t(a.height) * memory_cost::kPixel,
+                          fmt::format("the {}x{} image's buffers", a.width, a.height));
   scene.setCamera(scene::Camera::fromDesc(cam, float(a.width) / float(a.height)));
 
   // Light tree and evaluator; oriented lights weigh their normal cones by the scene's size.

@@ -6,6 +6,7 @@
 #include <initializer_list>
 #include <sstream>
 
+#include "core/memory_budget.h"
 #include "io/scene_desc.h"
 
 namespace lc::app {
@@ -134,6 +135,19 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
   c.add_option("--max-image-pixels", o.limits.maxImagePixels,
                fmt::format("Limit on width x height; default {}", o.limits.maxImagePixels))
       ->check(kLimitValue)
+      ->group(limitsGroup);
+  // One process-wide budget (core/memory_budget.h): set here, counted by the loaders.
+  c.add_option_function<std::string>(
+       "--max-memory", [](const std::string& v) { processBudget().setLimit(*parseBytes(v)); },
+       fmt::format("Budget on the memory that the scene, its textures, lights and the image need, counted before "
+                   "they are allocated: bytes, or with a K/M/G/T suffix (8G); default 80% of physical memory "
+                   "({})",
+                   formatBytes(MemoryBudget::defaultLimit())))
+      ->check(CLI::Validator(
+          [](std::string& s) -> std::string {
+            return parseBytes(s) ? std::string() : "a memory size must be bytes >= 0, or with K/M/G/T (8G), got " + s;
+          },
+          "SIZE"))
       ->group(limitsGroup);
   c.add_option("--max-texture-pixels", o.limits.maxTexturePixels,
                fmt::format("Limit on the pixels of one texture; default {}", o.limits.maxTexturePixels))

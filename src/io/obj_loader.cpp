@@ -81,6 +81,7 @@
 #include <unordered_map>
 
 #include "core/file_util.h"
+#include "core/memory_budget.h"
 #include "io/ray_writer.h"
 
 namespace fs = std::filesystem;
@@ -313,6 +314,11 @@ ObjScan scanObj(const std::string& text, const std::string& path, const Limits& 
     throwLimit(referredFrom, "OBJ file " + quoteInput(path) + " has " + std::to_string(scan.positions) +
                 " vertices, more than the limit of " + std::to_string(limits.maxVertices) +
                 " (raise it with --max-triangles)");
+  // Checked here, before the mesh is built; the parser counts it once it is complete.
+  const uint64_t bytes = scan.positions * memory_cost::kMeshVertex + scan.triangles * memory_cost::kMeshTriangle;
+  if (!processBudget().fits(bytes))
+    throwLimit(referredFrom, processBudget().overBudget(
+                                 bytes, "the " + std::to_string(scan.triangles) + " triangles of OBJ file " + quoteInput(path)));
   return scan;
 }
 

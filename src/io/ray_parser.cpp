@@ -16,6 +16,7 @@
 #include <unordered_map>
 
 #include "core/file_util.h"
+#include "core/memory_budget.h"
 #include "io/obj_loader.h"
 #include "io/ray_lexer.h"
 
@@ -107,6 +108,17 @@ class Parser {
     if (scene_.objects.size() + scene_.materials.size() >= opt_.limits.maxObjects)
       fail(at, "more objects and materials than the limit of " + std::to_string(opt_.limits.maxObjects) +
                    " (raise it with --max-objects)");
+    if (!processBudget().tryReserve(memory_cost::kRayItem)) {
+      const uint64_t n = scene_.objects.size() + scene_.materials.size();
+      fail(at, processBudget().overBudget((n + 1) * memory_cost::kRayItem,
+                                          std::to_string(n + 1) + " objects and materials",
+                                          n * memory_cost::kRayItem));
+    }
+  }
+  // Counts a finished mesh's points and triangles against --max-memory.
+  void reserveMesh(const Token& at, uint64_t vertices, uint64_t triangles) const {
+    uint64_t bytes = vertices * memory_cost::kMeshVertex + triangles * memory_cost::kMeshTriangle;
+    if (!processBudget().tryReserve(bytes)) fail(at, processBudget().overBudget(bytes, "meshes"));
   }
   [[noreturn]] void expected(const std::string& what, const Token& got) const {
     fail(got, "expected " + what + ", got " + got.describe());
@@ -870,6 +882,7 @@ void Parser::areaLight(const Token& kw) {
   MeshDesc mesh;
   mesh.points = {corner, corner + u, corner + u + v, corner + v};
   mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  reserveMesh(kw, 4, 2);
   totalVertices_ += 4;
   totalTriangles_ += 2;
 
@@ -1214,6 +1227,9 @@ void Parser::checkMeshLimits(const Token& at, uint64_t vertices, uint64_t triang
   if (totalTriangles_ + triangles > opt_.limits.maxTriangles)
     fail(at, "more triangles than the limit of " + std::to_string(opt_.limits.maxTriangles) +
                  " (raise it with --max-triangles)");
+  // Checked as the mesh grows, counted (reserveMesh) once it is complete.
+  uint64_t bytes = vertices * memory_cost::kMeshVertex + triangles * memory_cost::kMeshTriangle;
+  if (!processBudget().fits(bytes)) fail(at, processBudget().overBudget(bytes, "meshes"));
 }
 
 // trimesh | polymesh {
@@ -1342,6 +1358,7 @@ void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
   perVertex(4, mesh.vertexMaterials.size());
 
   if (emission) obj.material = emissiveCopy(obj.material, *emission, emissionTok);
+  reserveMesh(kw, mesh.points.size(), mesh.triangles.size());
   totalVertices_ += mesh.points.size();
   totalTriangles_ += mesh.triangles.size();
   obj.kind = ShapeKind::Mesh;
@@ -1390,6 +1407,7 @@ void Parser::objMesh(const Token& kw, ObjectDesc& obj) {
   ObjData data = loadObj(resolveRelative(baseDir_, file), lex_.loc(kw),
                          scene_.materials[size_t(defaultMat_)], remaining);
   checkMeshLimits(kw, data.mesh.points.size(), data.mesh.triangles.size());
+  reserveMesh(kw, data.mesh.points.size(), data.mesh.triangles.size());
   totalVertices_ += data.mesh.points.size();
   totalTriangles_ += data.mesh.triangles.size();
   detail::appendObjMesh(scene_, std::move(data), std::move(obj), material, defaultMat_);

@@ -83,6 +83,7 @@
 #include <limits>
 
 #include "core/error.h"
+#include "core/memory_budget.h"
 
 namespace lc::lights {
 
@@ -711,6 +712,13 @@ std::vector<ObjectLightInfo> addObjectLights(scene::Scene& scene, const ObjectLi
                 fmt::format("luminous objects need {} lights ({} with the scene's other lights), more "
                             "than --max-lights ({})",
                             countText(total), countText(existing + total), options.maxLights));
+  }
+
+  if (!emitters.empty()) {
+    const uint64_t bytes = uint64_t(total) * memory_cost::kLight;
+    if (!processBudget().tryReserve(bytes))
+      throw Error(emitters.front().lum->loc,
+                  processBudget().overBudget(bytes, "the " + countText(total) + " lights of luminous objects"));
   }
 
   // Pass 2: allocate once, then fill each emitter's range.

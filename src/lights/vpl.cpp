@@ -33,6 +33,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/memory_budget.h"
 #include "core/rng.h"
 
 namespace lc::lights {
@@ -104,6 +105,10 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
   if (!std::isfinite(o.clamp) || o.clamp < 0) throw Error("the VPL clamp must be a finite number >= 0");
   VplInfo info;
   if (o.count == 0 || o.bounces == 0) return info;
+  // Each path leaves at least one VPL in a closed scene: count those before shooting, the
+  // rest (further bounces) once they are known.
+  uint64_t reserved = uint64_t(o.count) * memory_cost::kLight;
+  processBudget().reserve(reserved, fmt::format("{} VPLs", o.count));
 
   LightSet& set = scene.lights();
   const std::vector<Light> sources = set.lights;  // VPLs are not sources themselves
@@ -195,6 +200,8 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
   size_t count = 0;
   for (const auto& d : out) count += d.size();
   if (count > o.maxVpls) throw Error(fmt::format("{} VPLs exceed --max-vpls ({})", count, o.maxVpls));
+  if (uint64_t(count) * memory_cost::kLight > reserved)
+    processBudget().reserve(uint64_t(count) * memory_cost::kLight - reserved, fmt::format("{} VPLs", count));
 
   LightGroup vg;
   vg.diffuseOnly = true;
