@@ -161,12 +161,14 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
       float cosUp = up <= 0 ? (dMax > 0 ? std::max(-1.0f, up / dMax) : 0.0f)
                             : (dMin > 0 ? std::min(1.0f, up / dMin) : 1.0f);
       // The slack only rounds a positive bound up: a zero bound is exact (nothing reaches).
-      float cUp = std::max(0.0f, coneWiden(cosUp, node.cosHalfAngle, node.sinHalfAngle));
+      // One square root per bound: cheaper than the node's bytes it would take to store.
+      const float sinHalfAngle = std::sqrt(std::max(0.0f, 1 - node.cosHalfAngle * node.cosHalfAngle));
+      float cUp = std::max(0.0f, coneWiden(cosUp, node.cosHalfAngle, sinHalfAngle));
       if (cUp > 0) cUp = std::min(1.0f, cUp + kSlack);
       gUp *= type == LightType::Oriented ? cUp : g.falloff(cUp);
       if (lower) {
         // 0 means "may be 90 degrees or more", not a cosine: no lower bound then.
-        float cLo = dMax > 0 ? coneNarrow(std::max(0.0f, (pc - ph) / dMax), node.cosHalfAngle, node.sinHalfAngle) : 0.0f;
+        float cLo = dMax > 0 ? coneNarrow(std::max(0.0f, (pc - ph) / dMax), node.cosHalfAngle, sinHalfAngle) : 0.0f;
         gLo *= cLo <= 0 ? 0.0f : (type == LightType::Oriented ? cLo : g.falloff(cLo));
         sm = sm && cLo > 0;
       }

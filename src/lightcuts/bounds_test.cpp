@@ -99,7 +99,6 @@ TEST(ClusterBound, LightsFacingAwayGiveZero) {
     node.hi = Vec3(0.05f, 0.05f, 0.05f);
     node.axis = Vec3(std::sin(away), 0, std::cos(away));  // the point is along +z
     node.cosHalfAngle = std::cos(0.1f);
-    node.sinHalfAngle = std::sin(0.1f);
     node.intensity = Color(1);
     ShadingPoint sp;
     sp.p = Vec3(0, 0, 5);

@@ -83,7 +83,7 @@ inline void setNodeFromCluster(LightNode& n, const Cluster& c) {
   n.hi = c.hi;
   n.axis = c.axis;
   n.cosHalfAngle = c.cosHalfAngle;
-  n.sinHalfAngle = std::sqrt(std::max(0.0f, 1 - c.cosHalfAngle * c.cosHalfAngle));
+  n.lights = c.count;
   // Clamped: lights of huge power (sums beyond FLT_MAX) keep finite node intensities.
   n.intensity = vmin(c.intensity.toFloat(), Color(std::numeric_limits<float>::max()));
   n.rep = c.rep;

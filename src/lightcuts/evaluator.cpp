@@ -269,6 +269,9 @@ class Lightcuts final : public LightEvaluator {
         // minus lower, is scaled by the boundary rate when the criterion is tested: the
         // estimate's own error is second order, a partly hidden cluster's is not.
         const bool fo = firstOrder && smooth && found == CutVisibility::Visible;
+        // Its moments are read at the end if it stays in the cut: a miss there cost 17% of
+        // the cut loop (perf, 100k point lights).
+        if (fo) __builtin_prefetch(&tree.moments[(n.left - 1) / 2]);
         const bool scaled = rss && fo && !boundary;
         (scaled ? sumScaled : sumSq) += double(spread) * spread;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));

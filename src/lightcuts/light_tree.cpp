@@ -159,7 +159,6 @@ MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, uint32_t top,
     done.back().add(b);  // the left child's sums become this node's
     NodeMoments& mi = m[(n.left - 1) / 2];
     setMeans(mi, done.back());
-    mi.lights = tree.lightCount(n.left) + tree.lightCount(n.left + 1);
   }
   return done.back();
 }
@@ -192,7 +191,6 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
       tasks.push_back(i);
       continue;
     }
-    m[(n.left - 1) / 2].lights = count;
     uint32_t leftCount = (tree.preorder[n.left + 1] - tree.preorder[n.left] + 1) / 2;
     stack.emplace_back(n.left + 1, count - leftCount);
     stack.emplace_back(n.left, leftCount);

@@ -34,7 +34,8 @@ struct LightNode {
   Color intensity;      // summed RGB intensity of the cluster
   uint32_t rep;         // representative light (index into LightSet::lights)
   uint32_t left;        // first child (the second is left + 1); 0 = leaf
-  float sinHalfAngle;   // sqrt(1 - cosHalfAngle^2), kept so the bounds need no square root
+  uint32_t lights;      // how many lights the cluster holds (1 for a leaf): read by every
+                        // refinement (visibility probes), so it sits in the node, not beside it
   bool isLeaf() const { return left == 0; }
 };
 static_assert(sizeof(LightNode) == 64, "LightNode should fill one cache line");
@@ -52,7 +53,6 @@ struct SeedNodeData {
 struct NodeMoments {
   Vec3 centroid;  // mean position (directional trees: mean direction toward the light)
   Vec3 meanAxis;  // mean normal/axis, not normalised (oriented and spot lights)
-  uint32_t lights = 1;  // how many lights the node holds
 };
 
 struct LightTree {
@@ -64,7 +64,7 @@ struct LightTree {
   std::vector<SeedNodeData> seed;
   // Per inner node, at (left - 1) / 2: sibling pairs sit at nodes 1-2, 3-4, ..., so that is
   // each inner node's own slot (n - 1 of them). A leaf's moments are its light's
-  // (momentsOf); storing them would repeat the light (28 bytes per light).
+  // (momentsOf); storing them would repeat the light (24 bytes per light).
   std::vector<NodeMoments> moments;
   // Parallel to nodes: each node's position in a depth-first walk that visits the left
   // child (n.left) before the right one, so a subtree is a contiguous range. Reconstruction
@@ -76,13 +76,10 @@ struct LightTree {
     const LightNode& n = nodes[i];
     if (!n.isLeaf()) return moments[(n.left - 1) / 2];
     const Light& l = lights.lights[n.rep];
-    return NodeMoments{l.type == LightType::Directional ? -l.direction : l.position, l.direction, 1};
+    return NodeMoments{l.type == LightType::Directional ? -l.direction : l.position, l.direction};
   }
   // How many lights node i holds.
-  uint32_t lightCount(uint32_t i) const {
-    const LightNode& n = nodes[i];
-    return n.isLeaf() ? 1u : moments[(n.left - 1) / 2].lights;
-  }
+  uint32_t lightCount(uint32_t i) const { return nodes[i].lights; }
 };
 
 enum class TreeBuilder { Agglomerative, Seed };
