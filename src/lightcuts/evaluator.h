@@ -74,6 +74,15 @@ struct EvalStats {
   uint64_t hiddenClusters = 0;       // clusters kept in a cut as hidden by their probes
   uint64_t groupProbes = 0;          // rays testing groups of borrowed-visible nodes (reconstruction.h)
   uint64_t failedGroupProbes = 0;    // those groups found hidden where every sample saw them
+  // Time, filled by the caller's Visibility and shading loop where they measure it:
+  uint64_t tracedRays = 0;           // rays through the Visibility (shadow and probe rays)
+  uint64_t timedRays = 0;            // a random sample of them, timed
+  uint64_t timedRayNanos = 0;        // their summed time
+  uint64_t lightingNanos = 0;        // thread CPU time in light evaluation, rays included
+  // The time in shadow rays, estimated from the sample.
+  double shadowRaySeconds() const {
+    return timedRays ? double(timedRayNanos) * 1e-9 * double(tracedRays) / double(timedRays) : 0.0;
+  }
   std::array<uint64_t, kHistogramBuckets> cutHistogram{};
 
   void recordCut(uint32_t size) {
@@ -95,6 +104,10 @@ struct EvalStats {
     hiddenClusters += o.hiddenClusters;
     groupProbes += o.groupProbes;
     failedGroupProbes += o.failedGroupProbes;
+    tracedRays += o.tracedRays;
+    timedRays += o.timedRays;
+    timedRayNanos += o.timedRayNanos;
+    lightingNanos += o.lightingNanos;
     for (size_t i = 0; i < cutHistogram.size(); ++i) cutHistogram[i] += o.cutHistogram[i];
   }
 };
