@@ -113,6 +113,24 @@ sphere { material = { diffuse = (0.5, 0.5, 0.5); }; }
   EXPECT_NEAR(c.z, 1.0f, 0.012f);
 }
 
+// The Phong specular term under a uniform environment of radiance L adds
+// ks L / pi * integral of max(R.w, 0)^n over the lit hemisphere: at shininess 0 that is
+// 2 ks L whatever the view (docs/SCENE_FORMAT.md).
+TEST(Environment, SpecularAtShininessZeroAddsTwiceKsL) {
+  auto s = load(R"(SBT-raytracer 1.0
+camera { position = (0, 0, 4); look_at = (0, 0, 0); fov = 35; }
+environment_light { colour = (1, 1, 1); lights = 2048; }
+sphere { material = { specular = (0.25, 0.25, 0.25); shininess = 0; }; }
+)");
+  auto brute = lightcuts::makeBruteForce(s->lights());
+  RenderOptions o;
+  o.width = o.height = 16;
+  RenderResult r = render(*s, *brute, o);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x)
+      if (hitsSphere(*s, x, y, 16)) EXPECT_NEAR(r.image.at(x, y).y, 0.5f, 0.005f);
+}
+
 // A mirror reflects the environment: a reflective sphere with no diffuse term shows the
 // environment's radiance times kr where its reflected rays escape.
 TEST(Environment, ReflectedRaysThatEscapeSeeIt) {
