@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 #include "core/error.h"
 #include "core/rng.h"
@@ -51,6 +52,13 @@ void sampleEnvironment(const scene::Environment& env, int count, uint64_t seed, 
   const double perLight = S / (double(count) * kPi);  // every light's luminance
   toLight.reserve(size_t(count));
   intensity.reserve(size_t(count));
+  // Lights that land in one pixel smaller than an average light's share of the sphere
+  // (4 pi / N) become one light: the pixel's radiance is constant, so they differ only in
+  // direction within the pixel. Keeps a one-pixel sun in a map from becoming thousands of
+  // nearly parallel lights that a shadowed point must all test.
+  const double mergeBelow = 4 * kPi / count;
+  std::unordered_map<size_t, size_t> merged;  // pixel -> index of its light
+  std::vector<Vec3d> dirSum;
   for (int k = 0; k < count; ++k) {
     // A Hammersley point, shifted modulo 1 (Cranley-Patterson).
     double u1 = (double(k) + 0.5) / count + shift1, u2 = double(radicalInverse2(uint32_t(k))) + shift2;
@@ -69,8 +77,23 @@ void sampleEnvironment(const scene::Environment& env, int count, uint64_t seed, 
     double u = (double(i) + f2) / W;
     Color L = t.at(int(i), int(j));
     double Y = luminance(L);
-    toLight.push_back(env.direction(u, v));
-    intensity.push_back(L * float(perLight / Y));
+    Vec3 w = env.direction(u, v);
+    Color I = L * float(perLight / Y);
+    double omega = 2 * kPi / W * (cosEdge[j] - cosEdge[j + 1]);
+    if (omega < mergeBelow) {
+      auto [it, fresh] = merged.try_emplace(j * size_t(W) + i, toLight.size());
+      if (!fresh) {
+        size_t m = it->second;
+        dirSum[m] += w;
+        intensity[m] += I;
+        toLight[m] = normalize(dirSum[m].toFloat());
+        if (progress && (k & 1023) == 1023) progress->add(1024);
+        continue;
+      }
+    }
+    toLight.push_back(w);
+    intensity.push_back(I);
+    dirSum.push_back(Vec3d(w));
     if (progress && (k & 1023) == 1023) progress->add(1024);
   }
 }

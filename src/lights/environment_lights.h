@@ -6,7 +6,10 @@
 // strata). A light drawn in pixel p of radiance L_p, luminance Y_p, stands for the solid
 // angle 1 / (N pdf) = S / (N Y_p), S = sum over pixels of Y x solid angle, and gets the
 // intensity L_p S / (N Y_p pi): every light has the same luminance S / (N pi). A
-// sun_sky_light's sun is one more light of intensity (its irradiance) / pi.
+// sun_sky_light's sun is one more light of intensity (its irradiance) / pi. Lights drawn in
+// the same pixel, when the pixel is smaller than 4 pi / N steradians, are merged into one
+// (summed intensity, mean direction): a map's one-pixel sun becomes one light, not
+// thousands, so `lights` is an upper bound on the count.
 #pragma once
 
 #include <atomic>
@@ -35,8 +38,9 @@ struct EnvironmentLightInfo {
                            // surface facing every light at once, a check of the total
 };
 
-// Draws `count` directions from an environment's table: unit directions toward the light
-// (not the travel direction) and intensities, as described above. Exposed for tests.
+// Draws `count` directions from an environment's table (at most `count` lights after
+// merging): unit directions toward the light (not the travel direction) and intensities,
+// as described above. Exposed for tests.
 void sampleEnvironment(const scene::Environment& env, int count, uint64_t seed, std::vector<Vec3>& toLight,
                        std::vector<Color>& intensity, Progress* progress = nullptr);
 

@@ -98,6 +98,38 @@ TEST(EnvironmentLights, PowerMatchesTheMapsIntegralAndLightsShareOneLuminance) {
   std::filesystem::remove(path);
 }
 
+// A one-pixel sun in a 256x128 map: the thousands of lights drawn in its pixel (smaller than
+// 4 pi / N) become one light carrying their summed power, pointing into the pixel.
+TEST(EnvironmentLights, LightsInOneSmallPixelAreMerged) {
+  io::Image img(256, 128);
+  for (Color& c : img.pixels) c = Color(0.2f, 0.3f, 0.5f);
+  img.at(100, 40) = Color(50000, 45000, 40000);
+  std::string path = (std::filesystem::temp_directory_path() / "lc_env_test_sun.exr").string();
+  io::writeImage(path, img);
+  io::EnvironmentDesc d;
+  d.map = io::TextureRef{path, {}, true};
+  scene::Environment e = scene::Environment::build(d);
+  std::vector<Vec3> dirs;
+  std::vector<Color> I;
+  sampleEnvironment(e, 4096, 1, dirs, I);
+  std::filesystem::remove(path);
+  double sunOmega = 2 * kPi / 256 * (std::cos(kPi * 40 / 128) - std::cos(kPi * 41 / 128));
+  double sunY = luminance(Color(50000, 45000, 40000)) * sunOmega, total = 0;
+  int inSun = 0;
+  Color sunI(0);
+  for (size_t k = 0; k < dirs.size(); ++k) {
+    double u, v;
+    e.coordinates(dirs[k], u, v);
+    total += luminance(I[k]) * kPi;
+    if (int(u * 256) == 100 && int(v * 128) == 40) ++inSun, sunI = I[k];
+  }
+  EXPECT_EQ(inSun, 1);
+  EXPECT_LT(dirs.size(), 1000u);  // the sun's share of the 4,096 draws went into one light
+  EXPECT_NEAR(luminance(sunI) * kPi, sunY, 1e-3 * sunY);
+  double skyY = luminance(Color(0.2f, 0.3f, 0.5f)) * (4 * kPi - sunOmega);
+  EXPECT_NEAR(total, sunY + skyY, 1e-4 * (sunY + skyY));
+}
+
 TEST(EnvironmentLights, DirectionsAndCoordinatesAreInverseWithUpAndRotate) {
   io::EnvironmentDesc d;
   d.up = Vec3(0.3f, 0.2f, -0.9f);
