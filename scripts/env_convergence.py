@@ -35,7 +35,7 @@ def main():
                "--height", str(a.size), "--env-lights", str(n)]
         if a.threads:
             cmd += ["--threads", str(a.threads)]
-        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         return path
 
     ref = render(a.ref)
