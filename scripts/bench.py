@@ -70,6 +70,9 @@ ROWS = [
     # Occlusion-heavy scenes (issue 20): most lights are hidden from most points.
     dict(key="rooms", name="Rooms", scene="scenes/rooms.ray", gi=True),
     dict(key="column_hall", name="Column hall", scene="scenes/column_hall.ray", gi=True),
+    # Environment light (issue 24): thousands of directional lights from a sky model or a map.
+    dict(key="courtyard_sunsky", name="Courtyard, sun and sky", scene="scenes/courtyard_sunsky.ray"),
+    dict(key="garden_hdr", name="Garden, HDR map", scene="scenes/garden_hdr.ray"),
 ]
 
 # One sentence per with/without-GI pair, written after looking at the images.

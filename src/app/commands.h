@@ -10,6 +10,7 @@ void addRenderCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addObj2RayCommand(CLI::App& app);
+void addSkyCommand(CLI::App& app);
 
 // Exit status of the subcommand that ran (set by its callback).
 int& exitStatus();

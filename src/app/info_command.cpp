@@ -49,6 +49,7 @@ int runInfo(InfoArgs& a) {
   const Bounds3& b = s.bounds();
   j["bounds"] = {{"min", {b.lo.x, b.lo.y, b.lo.z}}, {"max", {b.hi.x, b.hi.y, b.hi.z}}};
   j["object_lights"] = objectLightsJson(ls.objectLights);
+  j["environment_lights"] = environmentLightsJson(ls.environmentLights);
   j["vpls"] = ls.vpls.vpls;
   if (a.json) {
     fmt::print("{}\n", j.dump(2));
@@ -67,6 +68,9 @@ int runInfo(InfoArgs& a) {
   for (const auto& o : ls.objectLights)
     fmt::print("object light  #{} {}: {} lights over area {:.4g}, power ({:.4g}, {:.4g}, {:.4g})\n", o.shape,
                o.name.empty() ? "(unnamed)" : o.name, o.lights, o.area, o.power.x, o.power.y, o.power.z);
+  for (const auto& e : ls.environmentLights)
+    fmt::print("environment  {}: {} directional lights, power ({:.4g}, {:.4g}, {:.4g})\n", e.what, e.lights, e.power.x,
+               e.power.y, e.power.z);
   if (ls.vpls.vpls) fmt::print("vpls       {} from {} paths\n", ls.vpls.vpls, ls.vpls.paths);
   for (const std::string& w : ls.warnings) fmt::print("warning    {}\n", w);
   return 0;

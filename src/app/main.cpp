@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   lc::app::addInfoCommand(app);
   lc::app::addCompareCommand(app);
   lc::app::addObj2RayCommand(app);
+  lc::app::addSkyCommand(app);
   try {
     app.parse(argc, argv);
     // No subcommand: the help, as for --help (stdout, status 0), rather than CLI11's

@@ -128,6 +128,7 @@ int runRender(RenderArgs& a) {
 
   a.load.threads = a.threads;
   a.load.objectLights.seed = a.seed;  // shifts the stratified object-light points
+  a.load.envSeed = a.seed;            // shifts the environment lights' point set
   // sRGB texture maps (from MTL files) are linearised only for a physically based output.
   a.load.linearizeSrgbTextures = tonemap == io::ToneMap::Srgb;
   a.load.quiet = a.quiet;
@@ -292,6 +293,7 @@ int runRender(RenderArgs& a) {
       j["tree_memory_bytes"] = forest.memoryBytes();
     }
     j["object_lights"] = objectLightsJson(ls.objectLights);
+    j["environment_lights"] = environmentLightsJson(ls.environmentLights);
     j["vpls"] = {{"paths", ls.vpls.paths}, {"count", ls.vpls.vpls}, {"time_s", ls.vpls.seconds},
                  {"clamp_distance", ls.vpls.clampDistance}};
     j["vpl_clamped_fraction"] = clampedFraction;

@@ -52,6 +52,18 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
     out.objectLights = lights::addObjectLights(*out.scene, olo);
     bar.finish();
   }
+  if (!out.scene->environments().empty()) {
+    // Before the VPLs: instant radiosity shoots from the environment's lights too.
+    lights::EnvironmentLightOptions eo;
+    eo.count = o.envLights;
+    eo.seed = o.envSeed;
+    eo.maxLights = o.limits.maxLights;
+    if (o.interruptible) eo.cancel = &interruptFlag();
+    ProgressBar bar("environment lights", o.quiet);
+    eo.progress = [&](double f) { bar.update(f); };
+    out.environmentLights = lights::addEnvironmentLights(*out.scene, eo);
+    bar.finish();
+  }
   if (o.gi) {
     lights::VplOptions v;
     const auto& ir = desc.instantRadiosity;

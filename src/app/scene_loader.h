@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/limits.h"
+#include "lights/environment_lights.h"
 #include "lights/object_lights.h"
 #include "lights/vpl.h"
 #include "scene/scene.h"
@@ -30,6 +31,10 @@ struct LoadOptions {
   // render --seed: overrides the scene's instant_radiosity seed when given; unset, the scene's
   // seed or VplOptions' default stands.
   std::optional<uint64_t> vplSeed;
+  // --env-lights N: directional lights per environment_light / sun_sky_light (overrides
+  // their `lights`); the point set's seed (render --seed).
+  std::optional<int> envLights;
+  uint64_t envSeed = 1;
   bool gi = true;             // --gi off ignores instant_radiosity and --vpls
   // Linearise sRGB-marked (MTL) textures: scene::BuildOptions::linearizeSrgbTextures.
   bool linearizeSrgbTextures = false;
@@ -42,12 +47,13 @@ struct LoadOptions {
 struct LoadedScene {
   std::unique_ptr<scene::Scene> scene;
   std::vector<lights::ObjectLightInfo> objectLights;
+  std::vector<lights::EnvironmentLightInfo> environmentLights;
   lights::VplInfo vpls;
   std::vector<std::string> warnings;
   std::string objDescription;  // the default camera/lights added for an OBJ file, in .ray syntax
   double loadSeconds = 0;      // parsing and textures
   double accelSeconds = 0;     // Embree BVH
-  double lightSeconds = 0;     // object lights and VPLs
+  double lightSeconds = 0;     // object lights, environment lights and VPLs
 };
 
 LoadedScene loadScene(const std::string& path, const LoadOptions& options);

@@ -108,6 +108,11 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
                                            "scene's, else {}", vpl.clamp))
       ->check(CLI::Range(0.0f, 1e6f))
       ->group(lightsGroup);
+  c.add_option_function<int>("--env-lights", [&o](const int& v) { o.envLights = v; },
+                             "Directional lights each environment_light / sun_sky_light becomes (overrides their "
+                             "`lights`); default the scene's, else 4096")
+      ->check(CLI::Range(1, 1 << 30))
+      ->group(lightsGroup);
   c.add_option_function<std::string>("--gi", [&o](const std::string& v) { o.gi = v == "on"; },
                                      fmt::format("Global illumination from VPLs: on or off; default {}", o.gi ? "on" : "off"))
       ->check(CLI::IsMember({"on", "off"}))

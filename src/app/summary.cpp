@@ -27,4 +27,11 @@ nlohmann::json objectLightsJson(const std::vector<lights::ObjectLightInfo>& info
   return objs;
 }
 
+nlohmann::json environmentLightsJson(const std::vector<lights::EnvironmentLightInfo>& infos) {
+  nlohmann::json envs = nlohmann::json::array();
+  for (const auto& e : infos)
+    envs.push_back({{"what", e.what}, {"lights", e.lights}, {"power", {e.power.x, e.power.y, e.power.z}}});
+  return envs;
+}
+
 }  // namespace lc::app

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "lights/environment_lights.h"
 #include "lights/object_lights.h"
 #include "scene/light.h"
 
@@ -17,5 +18,9 @@ nlohmann::json lightCountsJson(const LightSet& lights);
 std::string lightCountsLine(const LightSet& lights);
 // One object per luminous object: shape, name, lights, area, power.
 nlohmann::json objectLightsJson(const std::vector<lights::ObjectLightInfo>& infos);
+
+// One object per environment_light / sun_sky_light: what it is, its directional lights
+// and their power (sum of intensities x pi).
+nlohmann::json environmentLightsJson(const std::vector<lights::EnvironmentLightInfo>& infos);
 
 }  // namespace lc::app

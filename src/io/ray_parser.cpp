@@ -87,7 +87,8 @@ bool isTopLevelOnlyWord(const Token& t) {
   if (t.kind != TokenKind::Ident || t.quoted) return false;
   const std::string& w = t.word;
   return w == "camera" || w == "ambient_light" || w == "point_light" || w == "directional_light" ||
-         w == "spot_light" || w == "area_light" || w == "instant_radiosity";
+         w == "spot_light" || w == "area_light" || w == "instant_radiosity" || w == "environment_light" ||
+         w == "sun_sky_light";
 }
 
 class Parser {
@@ -204,6 +205,10 @@ class Parser {
   void light(const Token& kw);
   void areaLight(const Token& kw);
   void instantRadiosity(const Token& kw);
+  void environmentLight(const Token& kw);
+  void sunSkyLight(const Token& kw);
+  // `lights = n` of environment_light / sun_sky_light: an integer in [1, --max-lights].
+  int envLightCount();
   void node();
   bool closeFrames();
   Mat4 transformArgs(const Token& kw);
@@ -466,6 +471,8 @@ SceneDesc Parser::run() {
     else if (w == "point_light" || w == "directional_light" || w == "spot_light") light(kw);
     else if (w == "area_light") areaLight(kw);
     else if (w == "instant_radiosity") instantRadiosity(kw);
+    else if (w == "environment_light") environmentLight(kw);
+    else if (w == "sun_sky_light") sunSkyLight(kw);
     else unknown(kw, "");
   }
   if (!ignoredPbr_.empty()) {
@@ -944,6 +951,114 @@ void Parser::instantRadiosity(const Token& kw) {
     return true;
   });
   scene_.instantRadiosity = ir;
+}
+
+int Parser::envLightCount() {
+  Token t = lex_.peek();
+  uint64_t n = integerValue("lights", std::min<uint64_t>(opt_.limits.maxLights, INT32_MAX), "--max-lights");
+  if (n == 0) fail(t, "lights must be >= 1, got 0");
+  return int(n);
+}
+
+// environment_light {
+//   map = "sky.hdr";     optional equirectangular map (.hdr, .exr or an 8-bit image stb reads,
+//                        sRGB-decoded): linear radiance; relative to the .ray file's directory
+//   colour = (r,g,b);    >= 0, multiplies the map; without a map a uniform environment; (1,1,1)
+//   intensity = s;       >= 0, scale; default 1
+//   up = (x,y,z);        the map's zenith, not zero; default (0,1,0)
+//   rotate = degrees;    about up (right-handed); default 0
+//   lights = n;          directional lights it becomes, >= 1; default 4096 (--env-lights overrides)
+//   visible = true;      seen by camera, reflected and refracted rays that miss everything
+// }
+// Radiance convention: a diffuse surface of albedo kd under a uniform environment of
+// radiance L, unoccluded, renders as kd * L (pbrt's). See docs/SCENE_FORMAT.md.
+void Parser::environmentLight(const Token& kw) {
+  EnvironmentDesc e;
+  e.kind = EnvironmentKind::Map;
+  e.loc = lex_.loc(kw);
+  block("environment_light", [&](const Token& k) {
+    const std::string& w = k.word;
+    if (!oneOf(w, {"map", "color", "intensity", "up", "rotate", "lights", "visible"})) return false;
+    expectEquals();
+    if (w == "map") {
+      Token f = lex_.next();
+      if (f.kind != TokenKind::Ident) expected("a file name (\"sky.hdr\")", f);
+      if (f.text.empty()) fail(f, "empty environment map file name");
+      TextureRef ref;
+      ref.path = resolveRelative(baseDir_, f.text);
+      ref.loc = lex_.loc(f);
+      ref.srgb = true;  // 8-bit maps are sRGB-encoded; .hdr and .exr stay linear
+      e.map = ref;
+    } else if (w == "color") {
+      Token open;
+      e.colour = vec3(&open);
+      if (!(e.colour.x >= 0 && e.colour.y >= 0 && e.colour.z >= 0))
+        fail(open, "environment_light colour must be >= 0 in every component");
+    } else if (w == "intensity") {
+      e.intensity = nonNegative("intensity");
+    } else if (w == "up") {
+      Token open;
+      e.up = coord(&open);
+      if (e.up.x == 0 && e.up.y == 0 && e.up.z == 0) fail(open, "up must not be zero");
+    } else if (w == "rotate") {
+      e.rotateDegrees = floatValue();
+    } else if (w == "lights") {
+      e.lights = envLightCount();
+    } else {
+      e.visible = boolValue();
+    }
+    return true;
+  });
+  scene_.environments.push_back(std::move(e));
+}
+
+// sun_sky_light {
+//   direction = (x,y,z); the direction sunlight travels (as directional_light), y up; the sun
+//                        must be above the horizon (y < 0); default (0,-1,0)
+//   turbidity = t;       Preetham et al. 1999's atmospheric turbidity, in [2, 10]; default 3
+//   intensity = s;       >= 0; at 1 the sun and sky together light a white horizontal diffuse
+//                        surface to 1; default 1
+//   lights = n;          directional lights for the sky, >= 1 (the sun is one more); default 4096
+//   ground = (r,g,b);    >= 0: radiance below the horizon is ground * intensity (a ground of
+//                        that albedo under the same sun and sky); default (0,0,0)
+//   visible = true;      the sky (and sun disk) seen by rays that miss everything
+// }
+void Parser::sunSkyLight(const Token& kw) {
+  EnvironmentDesc e;
+  e.kind = EnvironmentKind::SunSky;
+  e.loc = lex_.loc(kw);
+  block("sun_sky_light", [&](const Token& k) {
+    const std::string& w = k.word;
+    if (!oneOf(w, {"direction", "turbidity", "intensity", "lights", "ground", "visible"})) return false;
+    expectEquals();
+    if (w == "direction") {
+      Token open;
+      e.sunDirection = coord(&open);
+      Vec3d d(e.sunDirection);
+      double len = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+      if (len == 0) fail(open, "direction must not be zero");
+      if (!(d.y < -1e-6 * len))
+        fail(open, "the sun must be above the horizon: direction (where sunlight travels) needs y < 0");
+    } else if (w == "turbidity") {
+      Token t = numberToken();
+      e.turbidity = toFloat(t);
+      if (!(e.turbidity >= 2 && e.turbidity <= 10))
+        fail(t, "turbidity must be in [2, 10] (the range of Preetham's model), got " + t.text);
+    } else if (w == "intensity") {
+      e.intensity = nonNegative("intensity");
+    } else if (w == "lights") {
+      e.lights = envLightCount();
+    } else if (w == "ground") {
+      Token open;
+      e.ground = vec3(&open);
+      if (!(e.ground.x >= 0 && e.ground.y >= 0 && e.ground.z >= 0))
+        fail(open, "ground must be >= 0 in every component");
+    } else {
+      e.visible = boolValue();
+    }
+    return true;
+  });
+  scene_.environments.push_back(std::move(e));
 }
 
 // ---------------------------------------------------------------------------------------

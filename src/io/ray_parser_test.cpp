@@ -1482,3 +1482,79 @@ TEST(RayParserLights, DefaultAttenuationReachesAreaLights) {
 
 }  // namespace
 }  // namespace lc::io
+
+// ---------------------------------------------------------------------------------------
+// environment_light and sun_sky_light (issue 24)
+
+namespace lc::io {
+namespace {
+
+TEST(RayParserEnvironment, EnvironmentLightReadsEveryField) {
+  SceneDesc s = parse(
+      "environment_light { map = \"sky.hdr\"; colour = (1, 0.5, 0.25); intensity = 2; up = (0, 0, 2);\n"
+      "  rotate = 90; lights = 1000; visible = false; }\n"
+      "environment_light { }\n");
+  ASSERT_EQ(s.environments.size(), 2u);
+  const EnvironmentDesc& e = s.environments[0];
+  EXPECT_EQ(e.kind, EnvironmentKind::Map);
+  ASSERT_TRUE(e.map);
+  EXPECT_EQ(e.map->path, "/base/sky.hdr");
+  EXPECT_TRUE(e.map->srgb);  // 8-bit maps are sRGB-decoded
+  expectVec(e.colour, 1, 0.5f, 0.25f);
+  EXPECT_EQ(e.intensity, 2);
+  expectVec(e.up, 0, 0, 2);
+  EXPECT_EQ(e.rotateDegrees, 90);
+  EXPECT_EQ(e.lights, 1000);
+  EXPECT_FALSE(e.visible);
+  EXPECT_EQ(e.loc.line, 2);
+  const EnvironmentDesc& d = s.environments[1];
+  EXPECT_FALSE(d.map);
+  expectVec(d.colour, 1, 1, 1);
+  EXPECT_EQ(d.lights, 4096);
+  EXPECT_TRUE(d.visible);
+}
+
+TEST(RayParserEnvironment, SunSkyLightReadsEveryField) {
+  SceneDesc s = parse("sun_sky_light { direction = (1, -2, 0); turbidity = 4.5; intensity = 3; lights = 512;\n"
+                      "  ground = (0.1, 0.2, 0.3); visible = false; }\n");
+  ASSERT_EQ(s.environments.size(), 1u);
+  const EnvironmentDesc& e = s.environments[0];
+  EXPECT_EQ(e.kind, EnvironmentKind::SunSky);
+  expectVec(e.sunDirection, 1, -2, 0);
+  EXPECT_EQ(e.turbidity, 4.5f);
+  EXPECT_EQ(e.intensity, 3);
+  EXPECT_EQ(e.lights, 512);
+  expectVec(e.ground, 0.1f, 0.2f, 0.3f);
+  EXPECT_FALSE(e.visible);
+}
+
+TEST(RayParserEnvironment, BadValuesAreErrorsAtTheirPlace) {
+  EXPECT_EQ(error("environment_light { lights = 0; }"), "t.ray:2:30: error: lights must be >= 1, got 0");
+  EXPECT_EQ(error("environment_light { lights = 2.5; }"),
+            "t.ray:2:30: error: expected an integer for lights, got number 2.5");
+  EXPECT_EQ(error("environment_light { intensity = -1; }"),
+            "t.ray:2:33: error: intensity must be >= 0, got -1");
+  EXPECT_EQ(error("environment_light {\n  colour = (1, -1, 0); }"),
+            "t.ray:3:12: error: environment_light colour must be >= 0 in every component");
+  EXPECT_EQ(error("environment_light { up = (0, 0, 0); }"), "t.ray:2:26: error: up must not be zero");
+  EXPECT_EQ(error("environment_light { map = (1); }"),
+            "t.ray:2:27: error: expected a file name (\"sky.hdr\"), got '('");
+  EXPECT_EQ(error("environment_light { glow = 1; }"),
+            "t.ray:2:21: error: unknown keyword 'glow' in environment_light");
+  EXPECT_EQ(error("environment_light { visible = 1; }"), "t.ray:2:31: error: expected true or false, got number 1");
+  EXPECT_EQ(error("sun_sky_light { direction = (0, 1, 0); }"),
+            "t.ray:2:29: error: the sun must be above the horizon: direction (where sunlight travels) needs y < 0");
+  EXPECT_EQ(error("sun_sky_light { turbidity = 1; }"),
+            "t.ray:2:29: error: turbidity must be in [2, 10] (the range of Preetham's model), got 1");
+  EXPECT_EQ(error("sun_sky_light { ground = (0, -0.5, 0); }"),
+            "t.ray:2:26: error: ground must be >= 0 in every component");
+  EXPECT_EQ(error("sun_sky_light { map = \"x.hdr\"; }"), "t.ray:2:17: error: unknown keyword 'map' in sun_sky_light");
+  EXPECT_EQ(error("{ sun_sky_light { } }"), "t.ray:2:3: error: expected a primitive, transform or '{', got 'sun_sky_light'");
+  ParseOptions few;
+  few.limits.maxLights = 100;
+  EXPECT_EQ(error("environment_light { lights = 101; }", few),
+            "t.ray:2:30: error: lights 101 is more than the limit of 100 (raise it with --max-lights)");
+}
+
+}  // namespace
+}  // namespace lc::io

@@ -60,6 +60,7 @@ class Writer {
     }
     for (const LightDesc& l : s_.lights) light(l);
     if (s_.instantRadiosity) instantRadiosity(*s_.instantRadiosity);
+    for (const EnvironmentDesc& e : s_.environments) environment(e);
     for (const ObjectDesc& o : s_.objects) object(o);
     return std::move(out_);
   }
@@ -197,6 +198,29 @@ class Writer {
         break;
     }
     out_ += "}\n";
+  }
+
+  void environment(const EnvironmentDesc& e) {
+    if (e.kind == EnvironmentKind::Map) {
+      out_ += "\nenvironment_light {\n";
+      if (e.map) {
+        out_ += "  map = ";
+        quoted(texturePath(e.map->path));
+        out_ += ";\n";
+      }
+      line("  ", "colour", e.colour);
+      line("  ", "intensity", e.intensity);
+      line("  ", "up", e.up);
+      line("  ", "rotate", e.rotateDegrees);
+    } else {
+      out_ += "\nsun_sky_light {\n";
+      line("  ", "direction", e.sunDirection);
+      line("  ", "turbidity", e.turbidity);
+      line("  ", "intensity", e.intensity);
+      line("  ", "ground", e.ground);
+    }
+    out_ += "  lights = " + std::to_string(e.lights) + ";\n";
+    out_ += std::string("  visible = ") + (e.visible ? "true" : "false") + ";\n}\n";
   }
 
   void instantRadiosity(const InstantRadiosityDesc& ir) {

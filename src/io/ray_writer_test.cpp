@@ -109,6 +109,21 @@ void expectSameScene(const SceneDesc& a, const SceneDesc& b) {
     EXPECT_EQ(a.instantRadiosity->clamp, b.instantRadiosity->clamp);
     EXPECT_EQ(a.instantRadiosity->seed, b.instantRadiosity->seed);
   }
+  ASSERT_EQ(a.environments.size(), b.environments.size());
+  for (size_t i = 0; i < a.environments.size(); ++i) {
+    const EnvironmentDesc &x = a.environments[i], &y = b.environments[i];
+    EXPECT_EQ(x.kind, y.kind);
+    expectSameTexture(x.map, y.map, "environment map");
+    EXPECT_EQ(x.colour, y.colour);
+    EXPECT_EQ(x.intensity, y.intensity);
+    EXPECT_EQ(x.up, y.up);
+    EXPECT_EQ(x.rotateDegrees, y.rotateDegrees);
+    EXPECT_EQ(x.lights, y.lights);
+    EXPECT_EQ(x.visible, y.visible);
+    EXPECT_EQ(x.sunDirection, y.sunDirection);
+    EXPECT_EQ(x.turbidity, y.turbidity);
+    EXPECT_EQ(x.ground, y.ground);
+  }
 
   ASSERT_EQ(a.objects.size(), b.objects.size());
   for (size_t i = 0; i < a.objects.size(); ++i) {
@@ -173,6 +188,8 @@ spot_light { position = (0, 3, 6); target = (0, 0, 0); color = (1, 0, 0); expone
 spot_light { size = 50; blend = 0.15; direction = (0, -1, 0); }
 instant_radiosity { vpls = 5000; bounces = 2; normalize = "object"; clamp = 0.05; seed = 12345678901234567; }
 instant_radiosity { normalize = power; }
+environment_light { map = "sky.exr"; colour = (1, 0.9, 0.8); intensity = 0.3; up = (0, 0, 1); rotate = 45; lights = 999; }
+sun_sky_light { direction = (0.1, -0.7, 0.2); turbidity = 2.5; intensity = 3; ground = (0.1, 0.2, 0.3); visible = false; }
 material = { name = shared; diffuse = (0.25, 0.5, 0.75); specular = map("spec.png"); shininess = 12.5; }
 sphere { }
 translate(1, 2, 3, rotate(1, 1, 0, 0.3, scale(0.1, 0.2, 0.3, {
@@ -202,6 +219,7 @@ TEST(RayWriter, RoundTripsEveryFeature) {
   ASSERT_EQ(s.objects.size(), 10u);
   ASSERT_EQ(s.lights.size(), 4u);
   ASSERT_TRUE(s.instantRadiosity);
+  ASSERT_EQ(s.environments.size(), 2u);
   roundTrip(s);
 }
 

@@ -138,6 +138,32 @@ struct InstantRadiosityDesc {
   SourceLoc loc;
 };
 
+// environment_light { map; colour; intensity; up; rotate; lights; visible; } and
+// sun_sky_light { direction; turbidity; intensity; lights; ground; visible; }: light from
+// infinitely far away in every direction, turned into `lights` directional lights when the
+// scene loads (lights/environment_lights.h). Radiance convention: a diffuse surface of
+// albedo kd under a uniform environment of radiance L, unoccluded, renders as kd * L.
+enum class EnvironmentKind { Map, SunSky };
+
+struct EnvironmentDesc {
+  EnvironmentKind kind = EnvironmentKind::Map;
+  // environment_light: an equirectangular map (linear radiance; 8-bit images sRGB-decoded),
+  // or none for a uniform environment of radiance colour * intensity.
+  std::optional<TextureRef> map;
+  Color colour{1, 1, 1};   // multiplies the map
+  float intensity = 1;     // scale (both kinds)
+  Vec3 up{0, 1, 0};        // the map's zenith
+  float rotateDegrees = 0; // about up
+  int lights = 4096;       // directional lights it becomes (--env-lights overrides)
+  bool visible = true;     // seen by camera, reflected and refracted rays that miss everything
+  // sun_sky_light (Preetham et al. 1999): the direction sunlight travels (y is up), the
+  // atmosphere's turbidity, and the radiance below the horizon (a ground of that albedo).
+  Vec3 sunDirection{0, -1, 0};
+  float turbidity = 3;
+  Color ground{0, 0, 0};
+  SourceLoc loc;
+};
+
 struct SceneDesc {
   std::string path;  // the scene file
   CameraDesc camera;
@@ -148,6 +174,7 @@ struct SceneDesc {
   std::vector<LightDesc> lights;
   Color ambient{0, 0, 0};  // sum of ambient_light colours
   std::optional<InstantRadiosityDesc> instantRadiosity;
+  std::vector<EnvironmentDesc> environments;  // environment_light and sun_sky_light blocks
   std::vector<std::string> warnings;  // e.g. what --lenient skipped
 };
 

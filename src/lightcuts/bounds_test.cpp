@@ -6,6 +6,7 @@
 
 #include "core/rng.h"
 #include "lightcuts/test_lights.h"
+#include "lightcuts/light_tree.h"
 
 namespace lc::lightcuts {
 namespace {
@@ -174,6 +175,73 @@ TEST_P(BoundProperty, SmoothMeansNoClampWithinTheCluster) {
   } else {
     EXPECT_EQ(smoothCount, 0);
   }
+}
+
+// An environment's worth of directional lights (issue 24): thousands over the whole sphere
+// of directions, denser in a "sky" cap and a "sun" spot, clustered by the agglomerative
+// builder. At random shading points every node of the tree, from the root (lights on all
+// sides of the surface) to the leaves, has lower <= true unshadowed sum <= upper.
+TEST(DirectionalTreeBounds, EveryNodeOfAnEnvironmentTreeBracketsItsLights) {
+  Rng r(2024, 24);
+  LightSet set;
+  LightGroup g;
+  g.atten = Attenuation{0, 0, 0, kInf};
+  set.groups.push_back(g);
+  const Vec3 sun = normalize(Vec3(0.3f, 0.8f, -0.5f));
+  for (int i = 0; i < 4096; ++i) {
+    Light l;
+    l.type = LightType::Directional;
+    l.group = 0;
+    Vec3 toLight = i % 4 == 0 ? randomInCone(r, sun, 0.05f)
+                   : i % 4 == 1 ? randomInCone(r, Vec3(0, 1, 0), 1.2f)
+                                : randomUnit(r);
+    l.direction = -toLight;
+    float s = 0.5f + r.uniform();
+    l.intensity = Color(0.3f + r.uniform(), 0.5f, 0.3f + r.uniform()) * (s / 4096);
+    set.lights.push_back(l);
+  }
+  std::vector<uint32_t> idx(set.lights.size());
+  for (uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
+  LightTree tree = buildAgglomerativeTree(set, idx, LightType::Directional, 0, 1);
+  ASSERT_EQ(tree.nodes.size(), 2 * idx.size() - 1);
+  std::vector<Color> sum(tree.nodes.size());
+  int lit = 0;
+  for (int k = 0; k < 300; ++k) {
+    ShadingPoint sp;
+    sp.p = Vec3(10 * r.uniform() - 5, 10 * r.uniform() - 5, 10 * r.uniform() - 5);
+    sp.n = randomUnit(r);
+    Vec3 v = randomUnit(r);
+    if (dot(v, sp.n) < 0) v = -v;
+    sp.r = normalize(reflect(v, sp.n));
+    sp.kd = Color(r.uniform(), r.uniform(), r.uniform());
+    sp.ks = r.below(2) ? Color(0) : Color(r.uniform(), r.uniform(), r.uniform());
+    const float shininess[] = {0, 1, 10, 64, 128};
+    sp.shininess = shininess[r.below(5)];
+    BoundFrames fr(sp);
+    // Children follow parents: sum bottom-up.
+    for (size_t i = tree.nodes.size(); i-- > 0;) {
+      const LightNode& n = tree.nodes[i];
+      if (n.isLeaf()) {
+        const Light& l = set.lights[n.rep];
+        Color mg;
+        Vec3 wi;
+        float d;
+        sum[i] = lightContribution(l, g, sp, mg, wi, d) ? mg * l.intensity : Color(0);
+      } else {
+        sum[i] = sum[n.left] + sum[n.left + 1];
+      }
+    }
+    for (size_t i = 0; i < tree.nodes.size(); ++i) {
+      Color lower;
+      Color upper = clusterBounds(tree.nodes[i], LightType::Directional, g, sp, fr, &lower);
+      for (int ch = 0; ch < 3; ++ch) {
+        ASSERT_GE(upper[ch] * (1 + 1e-5f) + 1e-12f, sum[i][ch]) << "point " << k << " node " << i;
+        ASSERT_LE(lower[ch], sum[i][ch] * (1 + 1e-5f) + 1e-12f) << "point " << k << " node " << i;
+      }
+    }
+    lit += luminance(sum[0]) > 0;
+  }
+  EXPECT_GT(lit, 250);
 }
 
 }  // namespace

@@ -267,7 +267,8 @@ struct Tracer {
 
   Color trace(const Ray& ray, int depth) {
     Hit h;
-    if (!scene.intersect(ray, h)) return Color(0);
+    // A ray that escapes sees the environment (camera, reflected and refracted rays alike).
+    if (!scene.intersect(ray, h)) return scene.background(normalize(ray.d));
     scene::ShadingMaterial m = scene.shadingMaterial(h);
     Color L = m.ke + m.ka * scene.ambient();
     Vec3 v = -normalize(ray.d);

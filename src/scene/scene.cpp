@@ -266,6 +266,9 @@ std::unique_ptr<Scene> Scene::build(const io::SceneDesc& desc, const BuildOption
     s.lights_.lights.push_back(l);
   }
 
+  for (const io::EnvironmentDesc& ed : desc.environments)
+    s.environments_.push_back(Environment::build(ed, options.limits));
+
   float aspect = desc.camera.aspectRatio ? *desc.camera.aspectRatio : 1.0f;
   s.camera_ = Camera::fromDesc(desc.camera, aspect);
   s.buildGeometry(options);

@@ -13,6 +13,7 @@
 #include "core/limits.h"
 #include "io/scene_desc.h"
 #include "scene/camera.h"
+#include "scene/environment.h"
 #include "scene/light.h"
 #include "scene/material.h"
 #include "scene/shape.h"
@@ -87,6 +88,16 @@ class Scene {
   const Material& materialOf(const Hit& hit) const;
   const Bounds3& bounds() const { return bounds_; }
   Color ambient() const { return ambient_; }
+  // environment_light and sun_sky_light blocks (their directional lights are added by
+  // lights::addEnvironmentLights).
+  const std::vector<Environment>& environments() const { return environments_; }
+  // What a ray that escapes toward unit direction d sees: the sum of the visible
+  // environments (0 without any).
+  Color background(const Vec3& d) const {
+    Color c(0);
+    for (const Environment& e : environments_) c += e.background(d);
+    return c;
+  }
   LightSet& lights() { return lights_; }
   const LightSet& lights() const { return lights_; }
   const io::SceneDesc& desc() const { return desc_; }
@@ -102,6 +113,7 @@ class Scene {
   std::vector<Shape> shapes_;
   std::vector<Mesh> meshes_;
   LightSet lights_;
+  std::vector<Environment> environments_;
   Color ambient_;
   Bounds3 bounds_;
   float epsilon_ = 1e-4f;

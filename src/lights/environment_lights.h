@@ -1,0 +1,50 @@
+// Environment and sky light as directional lights (issue 24). Each environment_light or
+// sun_sky_light of the scene (scene/environment.h) becomes `lights` directional lights drawn
+// from its equirectangular table with density proportional to luminance x solid angle, on a
+// stratified point set (a Hammersley set, shifted by the seed, through the table's
+// marginal/conditional inversion: monotone in both coordinates, so the strata stay
+// strata). A light drawn in pixel p of radiance L_p, luminance Y_p, stands for the solid
+// angle 1 / (N pdf) = S / (N Y_p), S = sum over pixels of Y x solid angle, and gets the
+// intensity L_p S / (N Y_p pi): every light has the same luminance S / (N pi). A
+// sun_sky_light's sun is one more light of intensity (its irradiance) / pi. Lights drawn in
+// the same pixel, when the pixel is smaller than 4 pi / N steradians, are merged into one
+// (summed intensity, mean direction): a map's one-pixel sun becomes one light, not
+// thousands, so `lights` is an upper bound on the count.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/progress.h"
+#include "scene/scene.h"
+
+namespace lc::lights {
+
+struct EnvironmentLightOptions {
+  std::optional<int> count;  // --env-lights: overrides every block's `lights`
+  uint64_t seed = 1;         // --seed: shifts the point set
+  uint64_t maxLights = 20'000'000;
+  ProgressFn progress = {};  // the share of lights made (core/progress.h)
+  const std::atomic<bool>* cancel = nullptr;  // stops and throws lc::Interrupted
+};
+
+struct EnvironmentLightInfo {
+  std::string what;  // Environment::describe()
+  uint64_t lights = 0;     // directional lights added (the sun's included)
+  Color power;             // sum of the lights' intensities x pi: the irradiance of a
+                           // surface facing every light at once, a check of the total
+};
+
+// Draws `count` directions from an environment's table (at most `count` lights after
+// merging): unit directions toward the light (not the travel direction) and intensities,
+// as described above. Exposed for tests.
+void sampleEnvironment(const scene::Environment& env, int count, uint64_t seed, std::vector<Vec3>& toLight,
+                       std::vector<Color>& intensity, Progress* progress = nullptr);
+
+// Appends every environment's directional lights to scene.lights().
+std::vector<EnvironmentLightInfo> addEnvironmentLights(scene::Scene& scene, const EnvironmentLightOptions& options);
+
+}  // namespace lc::lights
