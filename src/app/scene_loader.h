@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/limits.h"
+#include "lights/caustics.h"
 #include "lights/object_lights.h"
 #include "lights/vpl.h"
 #include "scene/scene.h"
@@ -30,7 +31,12 @@ struct LoadOptions {
   // render --seed: overrides the scene's instant_radiosity seed when given; unset, the scene's
   // seed or VplOptions' default stands.
   std::optional<uint64_t> vplSeed;
-  bool gi = true;             // --gi off ignores instant_radiosity and --vpls
+  bool gi = true;             // --gi off ignores instant_radiosity's VPLs and --vpls (not caustics)
+  // Caustics (lights/caustics.h): --caustics and --caustic-lights over instant_radiosity's
+  // caustics and caustic_lights.
+  std::optional<int> causticPaths;
+  std::optional<std::string> causticLights;
+  std::optional<float> causticSmoothing;
   // Linearise sRGB-marked (MTL) textures: scene::BuildOptions::linearizeSrgbTextures.
   bool linearizeSrgbTextures = false;
   bool quiet = false;
@@ -43,6 +49,7 @@ struct LoadedScene {
   std::unique_ptr<scene::Scene> scene;
   std::vector<lights::ObjectLightInfo> objectLights;
   lights::VplInfo vpls;
+  lights::CausticInfo caustics;
   std::vector<std::string> warnings;
   std::string objDescription;  // the default camera/lights added for an OBJ file, in .ray syntax
   double loadSeconds = 0;      // parsing and textures
