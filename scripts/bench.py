@@ -73,6 +73,14 @@ ROWS = [
     # Environment light (issue 24): thousands of directional lights from a sky model or a map.
     dict(key="courtyard_sunsky", name="Courtyard, sun and sky", scene="scenes/courtyard_sunsky.ray"),
     dict(key="garden_hdr", name="Garden, HDR map", scene="scenes/garden_hdr.ray"),
+    # Caustics (issue 25): each scene without caustic lights (light through glass by the
+    # kt-weighted shadow ray; mirrors cast plain shadows) and with them (extra: render flags).
+    dict(key="ball_lens", name="Ball lens, no caustics", scene="scenes/ball_lens.ray", extra=["--caustics", "0"]),
+    dict(key="ball_lens_caustics", name="Ball lens, caustics (1M paths)", scene="scenes/ball_lens.ray"),
+    dict(key="mirror_ring", name="Mirror ring, no caustics", scene="scenes/mirror_ring.ray", extra=["--caustics", "0"]),
+    dict(key="mirror_ring_caustics", name="Mirror ring, caustics (1M paths)", scene="scenes/mirror_ring.ray"),
+    dict(key="cornell_water_caustics", name="Cornell water, caustics (100k paths)", scene="scenes/cornell_water.ray",
+         gi=True, extra=["--caustics", "100000"]),
 ]
 
 # One sentence per with/without-GI pair, written after looking at the images.
@@ -276,12 +284,12 @@ class Driver:
         scene = row["scene"]
         base = os.path.join(self.work, row["key"])
         cmds = []
-        extra = []
+        extra = list(row.get("extra", []))
         res = dict(key=row["key"], name=row["name"], scene=scene, width=self.width, gi=bool(row.get("gi")),
                    loadavg=os.getloadavg()[0])
         if row.get("vpls"):
             paths, got = self.vpl_paths(scene, row["vpls"])
-            extra = ["--vpls", str(paths)] if paths else []
+            extra += ["--vpls", str(paths)] if paths else []
             res["vpl_paths"] = paths
         # lightcuts, first with a probe of brute force at a few pixels
         lc = [self.render(scene, base + "_lc", extra=extra, ref=self.k_probe, cut_heatmap=True, commands=cmds)]

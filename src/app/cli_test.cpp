@@ -536,7 +536,8 @@ TEST(CliUsage, RenderHelpIsGroupedAndStatesEveryDefault) {
         "--max-depth", "--threads", "--seed", "--method", "--tree", "--error", "--max-cut", "--cut-criterion",
         "--estimator", "--visibility-probes", "--reference-pixels", "--reconstruct", "--reconstruct-coarse",
         "--lenient", "--object-lights", "--object-light-placement", "--emission-density", "--default-attenuation",
-        "--vpls", "--bounces", "--vpl-normalize", "--vpl-clamp", "--gi", "--max-lights", "--max-vpls",
+        "--vpls", "--bounces", "--vpl-normalize", "--vpl-clamp", "--caustics", "--caustic-lights",
+        "--caustic-smoothing", "--gi", "--max-lights", "--max-vpls",
         "--max-triangles", "--max-nesting", "--max-objects", "--max-image-pixels", "--max-texture-pixels"}) {
     size_t p = h.find(std::string("\n  ") + name + " ");
     ASSERT_NE(p, std::string::npos) << name << " is missing:\n" << h;
@@ -682,6 +683,26 @@ TEST(CliRender, SeedDrivesTheVpls) {
   EXPECT_EQ(image("s7.ray", {"--seed", "1"}), one);
   // Without VPLs the seed changes nothing under brute force.
   EXPECT_EQ(image("s.ray", {"--gi", "off", "--seed", "1"}), image("s.ray", {"--gi", "off", "--seed", "7"}));
+}
+
+// Issue 25: --caustics N (over the scene's instant_radiosity caustics) and the stats' keys.
+TEST(CliRender, CausticsAreReportedInTheStats) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader +
+                                   "instant_radiosity { caustics = 1000; caustic_lights = vpl; }\n"
+                                   "camera { position = (0,5,6); look_at = (0,0.6,0); }\n"
+                                   "point_light { position = (0,8,0); colour = (48,48,48); }\n"
+                                   "rotate(1,0,0,-1.5708, scale(16, square { material = { diffuse = (0.8,0.8,0.8); }; }))\n"
+                                   "translate(0,1.6,0, sphere { material = { transmissive = (0.9,0.9,0.9); index = 1.5; }; })\n");
+  CliResult r = run({"render", "s.ray", "-o", "out.ppm", "-q", "--width", "16", "--caustics", "200000", "--stats", "s.json"},
+                    dir.path());
+  ASSERT_EQ(r.status, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(slurp(dir.file("s.json")));
+  EXPECT_GT(j["caustic_lights"].get<uint64_t>(), 500u);  // ~0.5% of the paths reach the ball
+  EXPECT_EQ(j["caustics"]["paths"].get<uint64_t>(), 200000u);
+  EXPECT_EQ(j["caustics"]["kind"].get<std::string>(), "vpl");  // the scene's
+  EXPECT_GE(j["caustics"]["time_s"].get<double>(), 0.0);
+  EXPECT_EQ(j["lights"]["total"].get<uint64_t>(), j["caustic_lights"].get<uint64_t>() + 1);
 }
 
 // A scene can come from a pipe (e.g. `lightcuts render <(generator)`): it is read up to

@@ -297,6 +297,13 @@ int runRender(RenderArgs& a) {
     j["vpls"] = {{"paths", ls.vpls.paths}, {"count", ls.vpls.vpls}, {"time_s", ls.vpls.seconds},
                  {"clamp_distance", ls.vpls.clampDistance}};
     j["vpl_clamped_fraction"] = clampedFraction;
+    j["caustic_lights"] = ls.caustics.lights;
+    j["caustics"] = {{"paths", ls.caustics.paths},
+                     {"lights", ls.caustics.lights},
+                     {"kind", lights::causticLightKindName(ls.caustics.kind)},
+                     {"time_s", ls.caustics.seconds},
+                     {"mean_radius", ls.caustics.meanRadius},
+                     {"power", {ls.caustics.power.x, ls.caustics.power.y, ls.caustics.power.z}}};
     if (ref.pixels > 0) {
       j["reference"] = {{"pixels", ref.pixels},
                         {"brute_seconds", ref.bruteSeconds},
@@ -326,6 +333,10 @@ int runRender(RenderArgs& a) {
     if (ls.vpls.vpls)
       fmt::print("vpls       {} from {} paths in {}; clamp at {:.4g} removes {:.1f}% of their light\n", ls.vpls.vpls,
                  ls.vpls.paths, formatSeconds(ls.vpls.seconds), ls.vpls.clampDistance, 100 * clampedFraction);
+    if (ls.caustics.paths)
+      fmt::print("caustics   {} {} lights from {} paths in {} (footprint {:.4g}); shadow rays stop at glass\n",
+                 ls.caustics.lights, lights::causticLightKindName(ls.caustics.kind), ls.caustics.paths,
+                 formatSeconds(ls.caustics.seconds), ls.caustics.meanRadius);
     if (method == lightcuts::Method::Brute)
       fmt::print("method     brute force\n");
     else

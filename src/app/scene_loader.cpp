@@ -88,6 +88,28 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
       bar.finish();
     }
   }
+  {
+    // After the VPLs: caustic paths start from the scene's lights, not from VPLs.
+    lights::CausticOptions c;
+    const auto& ir = desc.instantRadiosity;
+    if (ir) {
+      if (ir->caustics) c.paths = *ir->caustics;
+      if (ir->causticLights) c.kind = lights::parseCausticLightKind(*ir->causticLights);
+      if (ir->seed) c.seed = *ir->seed;
+    }
+    if (o.causticPaths) c.paths = *o.causticPaths;
+    if (o.causticLights) c.kind = lights::parseCausticLightKind(*o.causticLights);
+    if (o.causticSmoothing) c.smoothing = *o.causticSmoothing;
+    if (o.vplSeed) c.seed = *o.vplSeed;
+    c.maxLights = o.limits.maxLights;
+    if (o.interruptible) c.cancel = &interruptFlag();
+    if (c.paths > 0) {
+      ProgressBar bar("caustics", o.quiet);
+      c.progress = [&](double f) { bar.update(f); };
+      out.caustics = lights::addCaustics(*out.scene, c);
+      bar.finish();
+    }
+  }
   // A signal caught after the last check: stop here, not after the next phase.
   if (o.interruptible && interruptFlag().load()) throw Interrupted();
   interrupts.reset();

@@ -10,6 +10,7 @@
 
 #include "core/limits.h"
 #include "lights/environment_lights.h"
+#include "lights/caustics.h"
 #include "lights/object_lights.h"
 #include "lights/vpl.h"
 #include "scene/scene.h"
@@ -35,7 +36,12 @@ struct LoadOptions {
   // their `lights`); the point set's seed (render --seed).
   std::optional<int> envLights;
   uint64_t envSeed = 1;
-  bool gi = true;             // --gi off ignores instant_radiosity and --vpls
+  bool gi = true;             // --gi off ignores instant_radiosity's VPLs and --vpls (not caustics)
+  // Caustics (lights/caustics.h): --caustics and --caustic-lights over instant_radiosity's
+  // caustics and caustic_lights.
+  std::optional<int> causticPaths;
+  std::optional<std::string> causticLights;
+  std::optional<float> causticSmoothing;
   // Linearise sRGB-marked (MTL) textures: scene::BuildOptions::linearizeSrgbTextures.
   bool linearizeSrgbTextures = false;
   bool quiet = false;
@@ -49,6 +55,7 @@ struct LoadedScene {
   std::vector<lights::ObjectLightInfo> objectLights;
   std::vector<lights::EnvironmentLightInfo> environmentLights;
   lights::VplInfo vpls;
+  lights::CausticInfo caustics;
   std::vector<std::string> warnings;
   std::string objDescription;  // the default camera/lights added for an OBJ file, in .ray syntax
   double loadSeconds = 0;      // parsing and textures

@@ -113,6 +113,25 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
                              "`lights`); default the scene's, else 4096")
       ->check(CLI::Range(1, 1 << 30))
       ->group(lightsGroup);
+  c.add_option_function<int>("--caustics", [&o](const int& v) { o.causticPaths = v; },
+                             "Caustics: light paths shot through mirrors and glass; each that reaches a diffuse surface "
+                             "leaves a caustic light, and shadow rays stop at glass (docs/LIGHTCUTS.md); default the "
+                             "scene's instant_radiosity caustics, else 0 (off)")
+      ->check(CLI::Range(0, 1 << 30))
+      ->group(lightsGroup);
+  c.add_option_function<std::string>("--caustic-lights", [&o](const std::string& v) { o.causticLights = v; },
+                                     fmt::format("Caustic lights: vpl (an oriented light lifted off the hit, facing "
+                                                 "it) or spot (the seed's: a spot at the last mirror or glass vertex); "
+                                                 "default the scene's, else {}",
+                                                 lights::causticLightKindName(lights::CausticOptions{}.kind)))
+      ->check(CLI::IsMember({"vpl", "spot"}))
+      ->group(lightsGroup);
+  c.add_option_function<float>("--caustic-smoothing", [&o](const float& v) { o.causticSmoothing = v; },
+                               fmt::format("Caustic lights' footprint, times the distance to the {}th nearest other "
+                                           "caustic hit; default {}", lights::CausticOptions{}.neighbours,
+                                           lights::CausticOptions{}.smoothing))
+      ->check(CLI::Range(1e-3f, 1e3f))
+      ->group(lightsGroup);
   c.add_option_function<std::string>("--gi", [&o](const std::string& v) { o.gi = v == "on"; },
                                      fmt::format("Global illumination from VPLs: on or off; default {}", o.gi ? "on" : "off"))
       ->check(CLI::IsMember({"on", "off"}))

@@ -922,14 +922,15 @@ void Parser::areaLight(const Token& kw) {
 }
 
 // instant_radiosity { vpls = n >= 0 (at most --max-vpls); bounces = n >= 0;
-//                     normalize = "power" | "object"; clamp = c >= 0; seed = 64-bit integer; }
+//                     normalize = "power" | "object"; clamp = c >= 0; seed = 64-bit integer;
+//                     caustics = n >= 0; caustic_lights = "vpl" | "spot"; }
 // Every field is optional; command-line flags override. A second block updates the first.
 void Parser::instantRadiosity(const Token& kw) {
   InstantRadiosityDesc ir = scene_.instantRadiosity.value_or(InstantRadiosityDesc{});
   ir.loc = lex_.loc(kw);
   block("instant_radiosity", [&](const Token& k) {
     const std::string& w = k.word;
-    if (!oneOf(w, {"vpls", "bounces", "normalize", "clamp", "seed"})) return false;
+    if (!oneOf(w, {"vpls", "bounces", "normalize", "clamp", "seed", "caustics", "caustic_lights"})) return false;
     expectEquals();
     if (w == "vpls") {
       ir.vpls = int(integerValue("vpls", std::min<uint64_t>(opt_.limits.maxVpls, INT32_MAX),
@@ -945,6 +946,13 @@ void Parser::instantRadiosity(const Token& kw) {
       ir.clamp = nonNegative("clamp");
     } else if (w == "seed") {
       ir.seed = integerValue("seed", UINT64_MAX);
+    } else if (w == "caustics") {
+      ir.caustics = int(integerValue("caustics", INT32_MAX));
+    } else if (w == "caustic_lights") {
+      Token t = lex_.next();
+      if (t.kind != TokenKind::Ident || (t.text != "vpl" && t.text != "spot"))
+        expected("\"vpl\" or \"spot\" for caustic_lights", t);
+      ir.causticLights = t.text;
     } else {
       return false;
     }

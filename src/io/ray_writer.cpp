@@ -234,6 +234,12 @@ class Writer {
     }
     if (ir.clamp) line("  ", "clamp", *ir.clamp);
     if (ir.seed) out_ += "  seed = " + std::to_string(*ir.seed) + ";\n";
+    if (ir.caustics) out_ += "  caustics = " + std::to_string(*ir.caustics) + ";\n";
+    if (ir.causticLights) {
+      out_ += "  caustic_lights = ";
+      quoted(sanitizeName(*ir.causticLights));
+      out_ += ";\n";
+    }
     out_ += "}\n";
   }
 

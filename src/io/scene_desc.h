@@ -128,13 +128,15 @@ struct LightDesc {
   SourceLoc loc;
 };
 
-// instant_radiosity { vpls; bounces; normalize; clamp; seed; }  (command line overrides)
+// instant_radiosity { vpls; bounces; normalize; clamp; seed; caustics; caustic_lights; }  (command line overrides)
 struct InstantRadiosityDesc {
   std::optional<int> vpls;
   std::optional<int> bounces;
   std::optional<std::string> normalize;  // "power" | "object"
   std::optional<float> clamp;
   std::optional<uint64_t> seed;
+  std::optional<int> caustics;                // light paths for caustic lights (lights/caustics.h)
+  std::optional<std::string> causticLights;  // "vpl" | "spot"
   SourceLoc loc;
 };
 

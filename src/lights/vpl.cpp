@@ -92,6 +92,68 @@ double lightPower(const Light& l, const LightGroup& g, float sceneRadius) {
 
 }  // namespace
 
+EmissionSampler::EmissionSampler(const scene::Scene& scene, const LightSet& set, std::vector<Light> sources)
+    : set_(set), sources_(std::move(sources)), eps_(scene.epsilon()) {
+  const Bounds3& bounds = scene.bounds();
+  radius_ = std::max(1e-6f, bounds.diagonal() * 0.5f);
+  centre_ = bounds.center();
+  cdf_.assign(sources_.size() + 1, 0.0);
+  for (size_t i = 0; i < sources_.size(); ++i)
+    cdf_[i + 1] = cdf_[i] + lightPower(sources_[i], set_.groups[sources_[i].group], radius_);
+  total_ = cdf_.back();
+}
+
+EmissionSampler::Sample EmissionSampler::sample(Rng& rng, size_t n) const {
+  double u = rng.uniformDouble() * total_;
+  size_t li = size_t(std::upper_bound(cdf_.begin(), cdf_.end(), u) - cdf_.begin()) - 1;
+  li = std::min(li, sources_.size() - 1);
+  while (li > 0 && cdf_[li + 1] == cdf_[li]) --li;  // never pick a zero-power light
+  const Light& L = sources_[li];
+  const LightGroup& g = set_.groups[L.group];
+  double pL = (cdf_[li + 1] - cdf_[li]) / total_;
+  Sample s;
+  s.light = &L;
+  s.group = &g;
+  Vec3& origin = s.origin;
+  Vec3& dir = s.dir;
+  float weight = 0;  // G(w) / p(w)
+  switch (L.type) {
+    case LightType::Omni:
+      origin = L.position;
+      dir = uniformSphere(rng.uniform(), rng.uniform());
+      weight = 4 * kPi;
+      break;
+    case LightType::Oriented:
+      dir = cosineHemisphere(L.direction, rng.uniform(), rng.uniform());
+      origin = L.position + L.direction * eps_;
+      weight = kPi;
+      break;
+    case LightType::Spot: {
+      float cosMax = spotCosMax(g.falloff);
+      float c = 1 - rng.uniform() * (1 - cosMax);
+      dir = aroundAxis(L.direction, c, 2 * kPi * rng.uniform());
+      origin = L.position;
+      weight = g.falloff(c) * 2 * kPi * (1 - cosMax);
+      break;
+    }
+    case LightType::Directional: {
+      dir = L.direction;
+      Vec3 a, bb;
+      orthonormalBasis(dir, a, bb);
+      float r = radius_ * std::sqrt(rng.uniform()), phi = 2 * kPi * rng.uniform();
+      origin = centre_ - dir * (2 * radius_) + a * (r * std::cos(phi)) + bb * (r * std::sin(phi));
+      weight = kPi * radius_ * radius_;
+      break;
+    }
+  }
+  s.flux = L.intensity * float(double(weight) / (pL * double(n)));
+  return s;
+}
+
+float EmissionSampler::Sample::firstHit(float t) const {
+  return light->type == LightType::Directional ? 1.0f : group->atten(t) * t * t;
+}
+
 VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
   auto t0 = std::chrono::steady_clock::now();
   if (o.count < 0) throw Error("--vpls must be >= 0");
@@ -112,15 +174,10 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
 
   LightSet& set = scene.lights();
   const std::vector<Light> sources = set.lights;  // VPLs are not sources themselves
-  const Bounds3& bounds = scene.bounds();
-  float radius = std::max(1e-6f, bounds.diagonal() * 0.5f);
-  Vec3 centre = bounds.center();
+  float radius = std::max(1e-6f, scene.bounds().diagonal() * 0.5f);
 
-  std::vector<double> cdf(sources.size() + 1, 0.0);
-  for (size_t i = 0; i < sources.size(); ++i)
-    cdf[i + 1] = cdf[i] + lightPower(sources[i], set.groups[sources[i].group], radius);
-  double total = cdf.back();
-  if (!(total > 0)) return info;
+  EmissionSampler emission(scene, set, sources);
+  if (!emission.hasPower()) return info;
 
   // Paths in blocks; each block's deposits are kept in path order, so the VPLs do not
   // depend on thread timing.
@@ -128,7 +185,6 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
   constexpr size_t kBlock = 1024;
   size_t blocks = (n + kBlock - 1) / kBlock;
   std::vector<std::vector<Deposit>> out(blocks);
-  const float eps = scene.epsilon();
   Progress progress(o.progress, double(n));
   auto cancelled = [&] { return o.cancel && o.cancel->load(std::memory_order_relaxed); };
   tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
@@ -136,50 +192,14 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
     std::vector<Deposit>& dep = out[b];
     for (size_t p = b * kBlock; p < std::min(n, (b + 1) * kBlock); ++p) {
       Rng rng(o.seed, p);
-      double u = rng.uniformDouble() * total;
-      size_t li = size_t(std::upper_bound(cdf.begin(), cdf.end(), u) - cdf.begin()) - 1;
-      li = std::min(li, sources.size() - 1);
-      while (li > 0 && cdf[li + 1] == cdf[li]) --li;  // never pick a zero-power light
-      const Light& L = sources[li];
-      const LightGroup& g = set.groups[L.group];
-      double pL = (cdf[li + 1] - cdf[li]) / total;
-      Vec3 origin, dir;
-      float weight = 0;  // G(w) / p(w)
-      switch (L.type) {
-        case LightType::Omni:
-          origin = L.position;
-          dir = uniformSphere(rng.uniform(), rng.uniform());
-          weight = 4 * kPi;
-          break;
-        case LightType::Oriented:
-          dir = cosineHemisphere(L.direction, rng.uniform(), rng.uniform());
-          origin = L.position + L.direction * eps;
-          weight = kPi;
-          break;
-        case LightType::Spot: {
-          float cosMax = spotCosMax(g.falloff);
-          float c = 1 - rng.uniform() * (1 - cosMax);
-          dir = aroundAxis(L.direction, c, 2 * kPi * rng.uniform());
-          origin = L.position;
-          weight = g.falloff(c) * 2 * kPi * (1 - cosMax);
-          break;
-        }
-        case LightType::Directional: {
-          dir = L.direction;
-          Vec3 a, bb;
-          orthonormalBasis(dir, a, bb);
-          float r = radius * std::sqrt(rng.uniform()), phi = 2 * kPi * rng.uniform();
-          origin = centre - dir * (2 * radius) + a * (r * std::cos(phi)) + bb * (r * std::sin(phi));
-          weight = kPi * radius * radius;
-          break;
-        }
-      }
-      Color flux = L.intensity * float(double(weight) / (pL * double(n)));
+      EmissionSampler::Sample e = emission.sample(rng, n);
+      Vec3 origin = e.origin, dir = e.dir;
+      Color flux = e.flux;
       bool first = true;
       for (int bounce = 1; bounce <= o.bounces; ++bounce) {
         scene::Hit h;
         if (!scene.intersect(scene::Ray{origin, dir, 0, kInf}, h)) break;
-        if (first && L.type != LightType::Directional) flux *= g.atten(h.t) * h.t * h.t;
+        if (first) flux *= e.firstHit(h.t);
         first = false;
         Color kd = scene.shadingMaterial(h).kd;
         if (isBlack(kd) || !isFinite(flux)) break;  // no diffuse surface, no VPL

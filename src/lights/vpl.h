@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/progress.h"
+#include "core/rng.h"
 #include "scene/scene.h"
 
 namespace lc::lights {
@@ -37,6 +38,35 @@ struct VplInfo {
   double seconds = 0;
   float clampDistance = 0;  // world units
   Color power;              // total intensity carried by the VPLs
+};
+
+// Light paths from a scene's lights: a light picked in proportion to its emitted power, a
+// direction from its emission (omni: the sphere; oriented: cosine; spot: the cone, weighted
+// by the falloff; directional: a disk covering the scene). Shared by the VPLs and the
+// caustics (lights/caustics.h).
+class EmissionSampler {
+ public:
+  EmissionSampler(const scene::Scene& scene, const LightSet& set, std::vector<Light> sources);
+  bool hasPower() const { return total_ > 0 && !sources_.empty(); }
+
+  struct Sample {
+    Vec3 origin, dir;
+    Color flux;  // the light's intensity * G(w) / (p(w) * P_light * n): what one of n paths carries
+    const Light* light = nullptr;
+    const LightGroup* group = nullptr;
+    // The factor for the first hit at distance t: atten(t) t^2 (1 for directional lights).
+    float firstHit(float t) const;
+  };
+  // One path of n, drawn with rng (its first draw picks the light). Needs hasPower().
+  Sample sample(Rng& rng, size_t n) const;
+
+ private:
+  const LightSet& set_;
+  std::vector<Light> sources_;
+  std::vector<double> cdf_;
+  double total_ = 0;
+  float radius_ = 1, eps_ = 1e-4f;
+  Vec3 centre_;
 };
 
 // Appends VPLs to scene.lights(). Throws lc::Error for bad options or limits.

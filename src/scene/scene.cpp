@@ -417,7 +417,7 @@ int Scene::firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t) c
 }
 
 Color Scene::transmittance(const Vec3& origin, const Vec3& dir, float tmax) const {
-  if (!hasTransmissive_) return occluded(origin, dir, tmax) ? Color(0) : Color(1);
+  if (!hasTransmissive_ || !shadowsThroughGlass_) return occluded(origin, dir, tmax) ? Color(0) : Color(1);
   // Walk the hits along the segment, multiplying transmissive colours (the course
   // renderer's shadow attenuation); an opaque hit ends the walk.
   Color T(1);

@@ -66,11 +66,16 @@ class Scene {
   // The nearest surface along the segment: its shape index and distance, or -1.
   int firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t) const;
   bool hasTransmissive() const { return hasTransmissive_; }
+  // Off, shadow rays treat transmissive surfaces as opaque (transmittance() is 0 or 1 and
+  // isTransmissive() is false): with caustics on, the light that passes glass is carried by
+  // the caustic lights alone (lights/caustics.h), not also by shadow rays. Default on.
+  void setShadowsThroughGlass(bool on) { shadowsThroughGlass_ = on; }
+  bool shadowsThroughGlass() const { return shadowsThroughGlass_; }
   // Whether a shape is a convex solid or a flat convex polygon: one that blocks a set of
   // directions from a point blocks their convex hull too.
   bool isConvex(int shape) const { return convex_[size_t(shape)] != 0; }
   // Whether light can pass through some part of a shape (a transmissive material).
-  bool isTransmissive(int shape) const { return transmissive_[size_t(shape)] != 0; }
+  bool isTransmissive(int shape) const { return shadowsThroughGlass_ && transmissive_[size_t(shape)] != 0; }
 
   // Material values at a hit (textures looked up, per-vertex materials blended).
   ShadingMaterial shadingMaterial(const Hit& hit) const;
@@ -118,6 +123,7 @@ class Scene {
   Bounds3 bounds_;
   float epsilon_ = 1e-4f;
   bool hasTransmissive_ = false;
+  bool shadowsThroughGlass_ = true;
   std::vector<uint8_t> convex_;        // per shape
   std::vector<uint8_t> transmissive_;  // per shape
   RTCDevice device_ = nullptr;
