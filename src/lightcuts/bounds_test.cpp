@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "core/rng.h"
-#include "lightcuts/test_lights.h"
+#include "test_lights.h"
 #include "lightcuts/light_tree.h"
 
 namespace lc::lightcuts {

@@ -4,7 +4,7 @@
 
 #include "core/error.h"
 #include "lightcuts/bounds.h"
-#include "lightcuts/test_lights.h"
+#include "test_lights.h"
 
 namespace lc::lightcuts {
 namespace {

@@ -21,6 +21,7 @@
 #include <string>
 
 #include "lightcuts/estimate.h"
+#include "lightcuts/eval_stats.h"
 #include "lightcuts/light_tree.h"
 #include "lightcuts/reconstruction.h"
 #include "lightcuts/shading.h"
@@ -58,58 +59,6 @@ struct CutOptions {
   // cluster is provably hidden (Visibility::trace) and stays in the cut as 0, with no
   // error, instead of being refined down to every light (the umbra of an emitter).
   bool visibilityProbes = true;
-};
-
-// Counters summed over shading points (per thread, then merged).
-struct EvalStats {
-  static constexpr int kHistogramBuckets = 24;  // cut sizes in [2^(i-1), 2^i), bucket 0 = 0
-  uint64_t shadingPoints = 0;
-  uint64_t cutNodes = 0;         // nodes (lights or clusters) in the cuts
-  uint64_t shadowRays = 0;
-  uint64_t boundsEvaluated = 0;
-  uint64_t reconstructedPoints = 0;  // shading points given a reconstruction cut
-  uint64_t probedClusters = 0;       // clusters tested for being hidden as a whole
-  uint64_t probeRays = 0;            // the shadow rays those tests cast (in shadowRays too)
-  uint64_t occludedRays = 0;         // shadow rays that found their light hidden
-  uint64_t hiddenClusters = 0;       // clusters kept in a cut as hidden by their probes
-  uint64_t groupProbes = 0;          // rays testing groups of borrowed-visible nodes (reconstruction.h)
-  uint64_t failedGroupProbes = 0;    // those groups found hidden where every sample saw them
-  // Time, filled by the caller's Visibility and shading loop where they measure it:
-  uint64_t tracedRays = 0;           // rays through the Visibility (shadow and probe rays)
-  uint64_t timedRays = 0;            // a random sample of them, timed
-  uint64_t timedRayNanos = 0;        // their summed time
-  uint64_t lightingNanos = 0;        // thread CPU time in light evaluation, rays included
-  // The time in shadow rays, estimated from the sample.
-  double shadowRaySeconds() const {
-    return timedRays ? double(timedRayNanos) * 1e-9 * double(tracedRays) / double(timedRays) : 0.0;
-  }
-  std::array<uint64_t, kHistogramBuckets> cutHistogram{};
-
-  void recordCut(uint32_t size) {
-    ++shadingPoints;
-    cutNodes += size;
-    int b = 0;
-    while (b + 1 < kHistogramBuckets && (uint64_t(1) << b) <= size) ++b;
-    ++cutHistogram[size_t(b)];
-  }
-  void add(const EvalStats& o) {
-    shadingPoints += o.shadingPoints;
-    cutNodes += o.cutNodes;
-    shadowRays += o.shadowRays;
-    boundsEvaluated += o.boundsEvaluated;
-    reconstructedPoints += o.reconstructedPoints;
-    probedClusters += o.probedClusters;
-    probeRays += o.probeRays;
-    occludedRays += o.occludedRays;
-    hiddenClusters += o.hiddenClusters;
-    groupProbes += o.groupProbes;
-    failedGroupProbes += o.failedGroupProbes;
-    tracedRays += o.tracedRays;
-    timedRays += o.timedRays;
-    timedRayNanos += o.timedRayNanos;
-    lightingNanos += o.lightingNanos;
-    for (size_t i = 0; i < cutHistogram.size(); ++i) cutHistogram[i] += o.cutHistogram[i];
-  }
 };
 
 struct EvalResult {

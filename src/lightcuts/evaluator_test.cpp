@@ -8,7 +8,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "lightcuts/bounds.h"
-#include "lightcuts/test_lights.h"
+#include "test_lights.h"
 
 namespace lc::lightcuts {
 namespace {

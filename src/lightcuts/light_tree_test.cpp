@@ -1,6 +1,6 @@
 #include "lightcuts/light_tree.h"
 #include "lightcuts/bounds.h"
-#include "lightcuts/test_lights.h"
+#include "test_lights.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "lightcuts/test_lights.h"
+#include "test_lights.h"
 
 namespace lc::lightcuts {
 namespace {

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include "lightcuts/evaluator.h"
 
 namespace lc::lightcuts {
 

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "lightcuts/eval_stats.h"
 #include "lightcuts/light_tree.h"
 #include "lightcuts/merged_batch.h"
 #include "lightcuts/shading.h"
@@ -31,7 +32,6 @@
 
 namespace lc::lightcuts {
 
-struct EvalStats;
 
 // What a sample's shadow ray toward a cut node's representative found.
 enum class CutVisibility : uint8_t {

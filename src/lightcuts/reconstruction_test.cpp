@@ -5,7 +5,7 @@
 #include <functional>
 
 #include "lightcuts/evaluator.h"
-#include "lightcuts/test_lights.h"
+#include "test_lights.h"
 
 namespace lc::lightcuts {
 namespace {
