@@ -43,7 +43,7 @@ int runCompare(const CompareArgs& a) {
   fmt::print("relative rmse          {:.4g}\n", m.relative_rmse);
   fmt::print("mean relative error    {:.4f}%\n", 100 * m.mean_relative_error);
   fmt::print("p99 relative error     {:.4f}%\n", 100 * m.p99_relative_error);
-  fmt::print("pixels over {:g}%       {:.4f}%\n", 100 * a.threshold, 100 * m.fraction_over_2pct);
+  fmt::print("pixels over {:g}%       {:.4f}%\n", 100 * a.threshold, 100 * m.fraction_over_threshold);
   fmt::print("max abs error          {:.6g}\n", m.max_abs_error);
   fmt::print("psnr                   {:.2f} dB\n", m.psnr);
   fmt::print("(relative error = |lum(test) - lum(ref)| / max(lum(ref), {:.4g}), the floor being 1% of the mean)\n", m.floor);
@@ -61,7 +61,7 @@ void addCompareCommand(CLI::App& app) {
   c->add_option("--heatmap", a->heatmap, "Write the per-pixel relative error, colour-mapped with a legend, to this PNG");
   c->add_option("--heatmap-max", a->heatmapMax, "Relative error at the top of the heatmap's scale (default 0.05)")
       ->check(CLI::Range(1e-6f, 1e6f));
-  c->add_option("--threshold", a->threshold, "Relative error counted by fraction_over_2pct (default 0.02)")
+  c->add_option("--threshold", a->threshold, "Relative error counted by fraction_over_threshold (also written as fraction_over_2pct; default 0.02)")
       ->check(CLI::Range(0.0, 1e6));
   c->callback([a] { exitStatus() = runCompare(*a); });
 }

@@ -314,6 +314,8 @@ int runRender(RenderArgs& a) {
                         {"p99_relative_error", ref.p99RelativeError},
                         {"max_relative_error", ref.maxRelativeError},
                         {"fraction_over_2pct", ref.fractionOver2pct},
+                        {"fraction_over_threshold", ref.fractionOver2pct},
+                        {"threshold", render::ReferenceStats::kThreshold},
                         {"brute_lights_per_shading_point", ref.bruteLightsPerShadingPoint}};
     }
     std::string text = j.dump(2) + "\n";

@@ -84,7 +84,8 @@ ImageMetrics compareImages(const Image& ref, const Image& test, double relThresh
     if (v > relThreshold) ++over;
   }
   m.mean_relative_error = sumRel / double(n);
-  m.fraction_over_2pct = double(over) / double(n);
+  m.fraction_over_threshold = double(over) / double(n);
+  m.threshold = relThreshold;
   // Nearest rank: the ceil(0.99 n)-th smallest, in integers to avoid 0.99*n rounding.
   size_t rank = (99 * n + 99) / 100;
   std::nth_element(e.begin(), e.begin() + long(rank - 1), e.end());
@@ -108,10 +109,11 @@ Image relativeErrorImage(const Image& ref, const Image& test) {
 std::string metricsToJson(const ImageMetrics& m) {
   return fmt::format(
       "{{\"rmse\": {}, \"relative_rmse\": {}, \"mean_relative_error\": {}, \"p99_relative_error\": {}, "
-      "\"fraction_over_2pct\": {}, \"psnr\": {}, \"max_abs_error\": {}, \"width\": {}, \"height\": {}, "
+      "\"fraction_over_2pct\": {}, \"fraction_over_threshold\": {}, \"threshold\": {}, \"psnr\": {}, \"max_abs_error\": {}, \"width\": {}, \"height\": {}, "
       "\"floor\": {}}}",
       jsonNumber(m.rmse), jsonNumber(m.relative_rmse), jsonNumber(m.mean_relative_error),
-      jsonNumber(m.p99_relative_error), jsonNumber(m.fraction_over_2pct), jsonNumber(m.psnr),
+      jsonNumber(m.p99_relative_error), jsonNumber(m.fraction_over_threshold),
+      jsonNumber(m.fraction_over_threshold), jsonNumber(m.threshold), jsonNumber(m.psnr),
       jsonNumber(m.max_abs_error), m.width, m.height, jsonNumber(m.floor));
 }
 

@@ -10,8 +10,8 @@
 //   mean_relative_error = mean of rel(p)
 //   p99_relative_error  = 99th percentile of rel(p), nearest rank: the ceil(0.99 N)-th
 //                         smallest value
-//   fraction_over_2pct  = fraction of pixels with rel(p) > relThreshold (0.02 by default;
-//                         the key keeps its name for any threshold)
+//   fraction_over_threshold = fraction of pixels with rel(p) > relThreshold (0.02 by
+//                         default); JSON also as fraction_over_2pct, its first name
 //   rmse                = sqrt(mean over all pixels and the R, G, B channels of diff^2)
 //   relative_rmse       = rmse / mean reference channel value (inf if that mean is 0 and
 //                         rmse > 0, 0 if both are 0)
@@ -36,7 +36,9 @@ struct ImageMetrics {
   double relative_rmse = 0;
   double mean_relative_error = 0;
   double p99_relative_error = 0;
-  double fraction_over_2pct = 0;
+  double fraction_over_threshold = 0;  // JSON: fraction_over_threshold, and fraction_over_2pct (the
+                                       // first name, kept for scripts) whatever the threshold
+  double threshold = 0.02;
   double psnr = 0;
   double max_abs_error = 0;
   int width = 0, height = 0;
@@ -52,7 +54,7 @@ std::vector<float> relativeErrors(const Image& ref, const Image& test);
 Image relativeErrorImage(const Image& ref, const Image& test);
 
 // One JSON object with exactly the keys rmse, relative_rmse, mean_relative_error,
-// p99_relative_error, fraction_over_2pct, psnr, max_abs_error, width, height, floor.
+// p99_relative_error, fraction_over_2pct, fraction_over_threshold, threshold, psnr, max_abs_error, width, height, floor.
 // Non-finite values (psnr of identical images, an infinite error) are written as null,
 // as JSON has no infinity. Doubles use the shortest form that reads back exactly.
 std::string metricsToJson(const ImageMetrics& m);

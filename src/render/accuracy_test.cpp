@@ -47,7 +47,7 @@ TEST(Accuracy, LightcutsWithinTwoPercentOfBruteForceOnTheCornellBox) {
   RenderResult ref = renderWith(s, *brute, W);
   RenderResult test = renderWith(s, *lc, W);
   io::ImageMetrics m = io::compareImages(ref.image, test.image);
-  EXPECT_LE(m.fraction_over_2pct, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
+  EXPECT_LE(m.fraction_over_threshold, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
   // And it did so with far fewer lights than brute force.
   double cut = double(test.stats.eval.cutNodes) / double(test.stats.eval.shadingPoints);
   EXPECT_LT(cut, 0.1 * double(s.lights().size()));
@@ -90,7 +90,7 @@ TEST(Accuracy, ReconstructionCutsWithinTwoPercentWithFarFewerShadowRays) {
   RenderResult full = renderWith(s, *lc, W);
   RenderResult rec = renderWith(s, *lc, W, 4);
   io::ImageMetrics m = io::compareImages(ref.image, rec.image);
-  EXPECT_LE(m.fraction_over_2pct, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
+  EXPECT_LE(m.fraction_over_threshold, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
   EXPECT_GT(rec.stats.reconstructionSamples, 0u);
   EXPECT_GT(rec.stats.eval.reconstructedPoints, rec.stats.eval.shadingPoints / 2);
   // Most points borrow visibility: fewer shadow rays than a lightcut at every point (in
@@ -102,7 +102,7 @@ TEST(Accuracy, ReconstructionCutsWithinTwoPercentWithFarFewerShadowRays) {
   // Coarse cells of 8 where their corners agree: fewer samples, the same accuracy.
   RenderResult coarse = renderWith(s, *lc, W, 4, 8);
   io::ImageMetrics mc = io::compareImages(ref.image, coarse.image);
-  EXPECT_LE(mc.fraction_over_2pct, 0.01) << "mean " << mc.mean_relative_error << " p99 " << mc.p99_relative_error;
+  EXPECT_LE(mc.fraction_over_threshold, 0.01) << "mean " << mc.mean_relative_error << " p99 " << mc.p99_relative_error;
   EXPECT_GT(coarse.stats.reconstructionCoarseCells, 0u);
   EXPECT_LT(coarse.stats.reconstructionSamples, rec.stats.reconstructionSamples);
   for (uint8_t d : coarse.done) ASSERT_EQ(d, 1);

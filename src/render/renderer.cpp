@@ -823,7 +823,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     size_t over = 0;
     for (double r : rel) {
       sum += r;
-      over += r > 0.02;
+      over += r > ReferenceStats::kThreshold;
     }
     rs.meanRelativeError = sum / double(std::max<size_t>(1, rel.size()));
     rs.maxRelativeError = rel.empty() ? 0 : rel.back();

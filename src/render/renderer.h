@@ -56,6 +56,8 @@ struct ReferenceStats {
   double p99RelativeError = 0;
   double maxRelativeError = 0;
   double fractionOver2pct = 0;
+  // The relative error that fractionOver2pct counts beyond (--stats: threshold).
+  static constexpr double kThreshold = 0.02;
   double bruteLightsPerShadingPoint = 0;
 };
 
