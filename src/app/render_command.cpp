@@ -155,13 +155,6 @@ int runRender(RenderArgs& a) {
   for (const std::string& w : ls.warnings) fmt::print(stderr, "lightcuts: {}\n", w);
   if (!ls.objDescription.empty() && !a.quiet)
     fmt::print(stderr, "OBJ input: added a default camera and lights:\n{}\n", ls.objDescription);
-  if (scene.lights().size() == 0)
-    printWarning("the scene has no lights: only emissive and ambient colours will show (add a point_light, "
-                 "directional_light, spot_light or area_light, or a luminosity to a material)");
-  const bool objInput = fileExtension(a.scene) == "obj";
-  if (objInput && !ls.objectLights.empty() && ls.vpls.vpls == 0 && a.load.gi && !a.load.vplCount)
-    printHint("the OBJ's emissive materials light what they see directly, nothing bounces; --vpls 10000 adds "
-              "indirect light (global illumination)");
 
   // Image size: from the flags, completing the missing one from the aspect ratio.
   const auto& cam = scene.desc().camera;
@@ -193,6 +186,14 @@ int runRender(RenderArgs& a) {
     camera.fovDegrees = std::atan(half) * 360.0f / kPi;
   }
   scene.setCamera(scene::Camera::fromDesc(camera, float(a.width) / float(a.height)));
+  // (after the checks above: an error is not preceded by warnings about a render that will not run)
+  if (scene.lights().size() == 0)
+    printWarning("the scene has no lights: only emissive and ambient colours will show (add a point_light, "
+                 "directional_light, spot_light or area_light, or a luminosity to a material)");
+  const bool objInput = fileExtension(a.scene) == "obj";
+  if (objInput && !ls.objectLights.empty() && ls.vpls.vpls == 0 && a.load.gi && !a.load.vplCount)
+    printHint("the OBJ's emissive materials light what they see directly, nothing bounces; --vpls 10000 adds "
+              "indirect light (global illumination)");
 
   // Light tree and evaluator; oriented lights weigh their normal cones by the scene's size.
   tb.sceneDiagonal = scene.bounds().diagonal();
