@@ -29,8 +29,12 @@ test: build
 bench: build
 	@./scripts/bench.sh
 
+# make install PREFIX=/usr DESTDIR=/tmp/stage: the binary in PREFIX/bin, the man page in
+# PREFIX/share/man/man1, the scenes in PREFIX/share/lightcuts, the docs in PREFIX/share/doc/lightcuts;
+# DESTDIR (staging, packaging) is prepended to all of them.
+PREFIX ?= /usr/local
 install: build
-	@cmake --install $(BUILD)
+	@DESTDIR=$(DESTDIR) cmake --install $(BUILD) --prefix $(PREFIX)
 
 # The suite (and the binary the CLI tests run) under AddressSanitizer, LeakSanitizer and
 # UndefinedBehaviorSanitizer (UB aborts). Tests named *Slow* are labelled "slow" and left

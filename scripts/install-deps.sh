@@ -16,6 +16,7 @@ pkgs=(
   nlohmann-json3-dev   # nlohmann/json: --stats and --json output
   libgtest-dev         # GoogleTest: the test suite
   libbenchmark-dev     # Google Benchmark: micro benchmarks under bench/
+  help2man             # the man page (lightcuts.1) from `lightcuts --help-all`; skipped without it
 )
 if [ $# -gt 0 ]; then pkgs=("$@"); fi
 missing=()

@@ -7,6 +7,8 @@
 #     no external script or style sheet, every image an inlined data URI),
 #   - Chromium writes a screenshot that is not blank,
 #   - the console shows no error (no CONSOLE message, no "Uncaught", no failed load).
+# and that the page is the user's: a table of contents linked to its headings, no heading that
+# names a project issue ("issue 3"), no hand-written notes from after the GENERATED markers.
 # Exits 77 (ctest: skipped) when chromium is not installed.
 #   scripts/test_report.sh [MARKDOWN ...]
 #   LC_REPORT_SCREENSHOT=shot.png scripts/test_report.sh   # keep the last screenshot
@@ -52,6 +54,8 @@ cat > "$fixture" <<'MDEOF'
 |---|---|---|---|
 | Cornell box | 100 s | 4 s | 25.0× |
 
+### Scaling (256×256, issue 3)
+
 ![a gradient](images/grad.png)
 
 <details><summary>Commands</summary>
@@ -85,6 +89,18 @@ for md in "${inputs[@]}"; do
      grep -Eio '<img[^>]+src="[^"]{0,5}' "$html" | grep -qv 'src="data:'; then
     echo "test_report: the page refers to external resources:" >&2
     grep -Eio '(src|href)="[^"]{0,80}' "$html" | grep -v 'data:' | head >&2
+    exit 1
+  fi
+  if grep -Eo '<h[1-6][^>]*>[^<]*issues? [0-9]' "$html" >&2; then
+    echo "test_report: a heading names a project issue (above)" >&2
+    exit 1
+  fi
+  if ! grep -q '<nav class="toc"><strong><a href="#measured-results">' "$html"; then
+    echo "test_report: no table of contents linked to the headings" >&2
+    exit 1
+  fi
+  if grep -q 'Notes on the generated figures' "$html"; then
+    echo "test_report: the developer notes after the GENERATED markers are in the page" >&2
     exit 1
   fi
   if grep -q '!\[' "$md" && ! grep -q 'src="data:image/png;base64,' "$html"; then

@@ -194,6 +194,8 @@ Row objRow(std::string name, std::string body, std::string message) {
 }
 
 const std::string kTri = "points = ((0,0,0),(1,0,0),(0,1,0));";
+const std::string kLenientHint =
+    "\nlightcuts: hint: --lenient skips unknown keywords (and their values) with a warning instead of failing";
 
 std::vector<Row> catalogue() {
   std::vector<Row> rows = {
@@ -216,9 +218,10 @@ std::vector<Row> catalogue() {
       ray("wrong_type", "cylinder { capped = 1; }",
           "wrong_type.ray:2:21: error: expected true or false, got number 1"),
       // ---- keywords
+      // (unknown keywords get a second line, a hint: kLenientHint)
       ray("unknown_keyword", "sphere { radius = 2; }",
-          "unknown_keyword.ray:2:10: error: unknown keyword 'radius' in sphere"),
-      ray("unknown_item", "teapot { size = 1; }", "unknown_item.ray:2:1: error: unknown keyword 'teapot'"),
+          "unknown_keyword.ray:2:10: error: unknown keyword 'radius' in sphere" + kLenientHint),
+      ray("unknown_item", "teapot { size = 1; }", "unknown_item.ray:2:1: error: unknown keyword 'teapot'" + kLenientHint),
       ray("duplicate_list", std::string("trimesh { ") + kTri + " points = ((0,0,0)); }",
           "duplicate_list.ray:2:47: error: 'points' is given twice in trimesh"),
       ray("second_camera", "camera {} camera {}",
@@ -532,7 +535,7 @@ TEST(CliUsage, RenderHelpIsGroupedAndStatesEveryDefault) {
   }
   EXPECT_TRUE(std::is_sorted(at.begin(), at.end())) << h;
   for (const char* name :
-       {"-o,--output", "--stats", "--cut-heatmap", "--tonemap", "-q,--quiet", "--width", "--height", "--spp",
+       {"-o,--output", "--stats", "--cut-heatmap", "--tonemap", "--exposure", "-q,--quiet", "--width", "--height", "--spp",
         "--max-depth", "--threads", "--seed", "--method", "--tree", "--error", "--max-cut", "--cut-criterion",
         "--estimator", "--visibility-probes", "--reference-pixels", "--reconstruct", "--reconstruct-coarse",
         "--lenient", "--object-lights", "--object-light-placement", "--emission-density", "--default-attenuation",
@@ -1089,6 +1092,253 @@ TEST(CliInterrupt, ErrorKeepsTheOldOutput) {
   CliResult r = run({"render", "bad.ray", "-o", "out.png", "-q"}, dir.path());
   EXPECT_EQ(r.status, 1);
   EXPECT_EQ(slurp(dir.file("out.png")), "old");
+}
+
+// ---------------------------------------------------------------------------------------
+// Warnings that explain a surprising image (issue 26): one line each on stderr,
+// "lightcuts: warning: ..." or "lightcuts: hint: ...", printed under -q too.
+
+// The lines of stderr that are warnings or hints.
+std::vector<std::string> notes(const std::string& err) {
+  std::vector<std::string> out;
+  size_t at = 0;
+  while (at < err.size()) {
+    size_t eol = err.find('\n', at);
+    if (eol == std::string::npos) eol = err.size();
+    std::string line = err.substr(at, eol - at);
+    if (line.rfind("lightcuts: warning: ", 0) == 0 || line.rfind("lightcuts: hint: ", 0) == 0) out.push_back(line);
+    at = eol + 1;
+  }
+  return out;
+}
+
+const std::string kLitFloor =
+    "camera { position = (0,1,4); viewdir = (0,-0.2,-1); }\n"
+    "translate(0,-1,0, rotate(1,0,0,-1.5708, scale(8, square { material = { diffuse = (0.8,0.8,0.8); }; })))\n"
+    "sphere { material = { diffuse = (0.8,0.3,0.2); }; }\n";
+
+TEST(CliWarnings, NoneForAnOrdinaryScene) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + kLitFloor + "point_light { position = (2,4,3); colour = (1,1,1); }\n");
+  CliResult r = run({"render", "s.ray", "-o", "out.png", "--width", "24", "-q"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+}
+
+TEST(CliWarnings, NoLights) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + kLitFloor);
+  CliResult r = run({"render", "s.ray", "-o", "out.png", "--width", "24", "-q"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(notes(r.err), std::vector<std::string>{
+                              "lightcuts: warning: the scene has no lights: only emissive and ambient colours will "
+                              "show (add a point_light, directional_light, spot_light or area_light, or a luminosity "
+                              "to a material)"});
+  EXPECT_TRUE(fs::exists(dir.file("out.png")));
+}
+
+TEST(CliWarnings, BlackImageSaysWhy) {
+  TempDir dir;
+  // The light inside the sphere: every shadow ray from the outside is blocked.
+  writeText(dir.file("inside.ray"), kHeader + kLitFloor + "point_light { position = (0,0,0); colour = (1,1,1); }\n");
+  // The camera looking away from everything.
+  writeText(dir.file("away.ray"), kHeader + "camera { position = (0,1,4); viewdir = (0,0,1); }\n" +
+                                      kLitFloor.substr(kLitFloor.find('\n') + 1) +
+                                      "point_light { position = (2,4,3); colour = (1,1,1); }\n");
+  // A light whose quadratic attenuation leaves about 1e-5 of it at the scene.
+  writeText(dir.file("weak.ray"), kHeader + kLitFloor +
+                                      "point_light { position = (2,4,3); colour = (1,1,1); "
+                                      "constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; "
+                                      "quadratic_attenuation_coeff = 3000; }\n");
+  auto warning = [&](const std::string& scene, std::vector<std::string> extra = {}, std::string out = "out.png") {
+    std::vector<std::string> args = {"render", scene, "-o", out, "--width", "24", "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    CliResult r = run(args, dir.path());
+    EXPECT_EQ(r.status, 0) << r.err;
+    std::vector<std::string> n = notes(r.err);
+    return n.empty() ? std::string() : n[0] + (n.size() > 1 ? " (and more)" : "");
+  };
+  std::string inside = warning("inside.ray");
+  EXPECT_EQ(inside.rfind("lightcuts: warning: the image is", 0), 0u) << inside;
+  EXPECT_NE(inside.find("black: everything is in shadow (100% of the shadow rays found their light blocked); a "
+                        "light may be inside or behind an object"),
+            std::string::npos)
+      << inside;
+  EXPECT_EQ(warning("inside.ray", {"--method", "brute"}), inside);
+  std::string away = warning("away.ray");
+  EXPECT_EQ(away.rfind("lightcuts: warning: the image is black: the camera sees almost nothing (0 shading points "
+                       "from 576 camera rays)", 0),
+            0u)
+      << away;
+  std::string weak = warning("weak.ray");
+  EXPECT_NE(weak.find("black: the light reaching the surfaces is too weak to show; check the lights' colours and "
+                      "their attenuation"),
+            std::string::npos)
+      << weak;
+  EXPECT_NE(weak.find("or raise --exposure"), std::string::npos) << weak;
+  // Raised by 2^16, the same scene shows: no warning; the 8-bit file is judged as written.
+  EXPECT_EQ(warning("weak.ray", {"--exposure", "16"}), "");
+  // An EXR is judged as it would be displayed (sRGB).
+  EXPECT_NE(warning("weak.ray", {}, "out.exr").find("too weak"), std::string::npos);
+  EXPECT_EQ(warning("weak.ray", {"--exposure", "16"}, "out.exr"), "");
+}
+
+TEST(CliWarnings, EmissiveObjWithoutGiHintsAtVpls) {
+  TempDir dir;
+  // A floor and a small lamp (Ke) above it, facing down.
+  writeText(dir.file("lamp.mtl"), "newmtl floor\nKd 0.8 0.8 0.8\nnewmtl lamp\nKd 0 0 0\nKe 5 5 5\n");
+  writeText(dir.file("lamp.obj"),
+            "mtllib lamp.mtl\nv -2 0 -2\nv 2 0 -2\nv 2 0 2\nv -2 0 2\nv -0.3 2 -0.3\nv 0.3 2 -0.3\nv 0.3 2 "
+            "0.3\nv -0.3 2 0.3\nusemtl floor\nf 1 4 3 2\nusemtl lamp\nf 5 6 7 8\n");
+  const std::string hint =
+      "lightcuts: hint: the OBJ's emissive materials light what they see directly, nothing bounces; --vpls 10000 "
+      "adds indirect light (global illumination)";
+  CliResult r = run({"render", "lamp.obj", "-o", "out.png", "--width", "16", "-q"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(notes(r.err), std::vector<std::string>{hint});
+  for (std::vector<std::string> flags : {std::vector<std::string>{"--vpls", "200"}, {"--gi", "off"}, {"--vpls", "0"}}) {
+    std::vector<std::string> args = {"render", "lamp.obj", "-o", "out.png", "--width", "16", "-q"};
+    args.insert(args.end(), flags.begin(), flags.end());
+    CliResult g = run(args, dir.path());
+    EXPECT_EQ(g.status, 0) << g.err;
+    EXPECT_EQ(notes(g.err), std::vector<std::string>{}) << flags[0] << " " << flags[1];
+  }
+}
+
+// The parser's warnings keep their location, in the errors' format.
+TEST(CliWarnings, LenientWarningsCarryTheirLocation) {
+  TempDir dir;
+  writeText(dir.file("s.ray"),
+            kHeader + kLitFloor + "point_light { position = (2,4,3); }\nsphere { radius = 2; }\n");
+  CliResult r = run({"render", "s.ray", "-o", "out.png", "--width", "16", "-q", "--lenient"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "lightcuts: s.ray:6:10: warning: unknown keyword 'radius' in sphere (skipped)\n");
+}
+
+// ---------------------------------------------------------------------------------------
+// Display-ready output (issue 26): 8-bit files are sRGB-encoded by default; --tonemap clamp
+// stores the values as the course renderer did; --exposure scales before either; EXR stays
+// linear. Metadata: scene, command line and version in PNG text chunks and EXR attributes.
+
+TEST(CliOutput, DefaultIsSrgbClampKeepsTheCourseLookExposureScales) {
+  TempDir dir;
+  // An ambient-only sphere filling the view: every pixel is linear 0.25 exactly.
+  writeText(dir.file("s.ray"), kHeader +
+                                   "camera { position = (0,0,0.5); viewdir = (0,0,-1); }\n"
+                                   "ambient_light { colour = (1,1,1); }\n"
+                                   "sphere { material = { ambient = (0.25,0.25,0.25); diffuse = (0,0,0); }; }\n");
+  auto centre = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"render", "s.ray", "-o", "o.ppm", "--width", "8", "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    CliResult r = run(args, dir.path());
+    EXPECT_EQ(r.status, 0) << r.err;
+    std::string ppm = slurp(dir.file("o.ppm"));
+    return ppm.empty() ? -1 : int(uint8_t(ppm[ppm.size() - 3 * 36 - 1]));  // a pixel near the centre
+  };
+  EXPECT_EQ(centre({}), 137);                             // sRGB(0.25)
+  EXPECT_EQ(centre({"--tonemap", "srgb"}), 137);
+  EXPECT_EQ(centre({"--tonemap", "clamp"}), 64);          // round(0.25 * 255)
+  EXPECT_EQ(centre({"--tonemap", "clamp", "--exposure", "1"}), 128);
+  EXPECT_EQ(centre({"--exposure", "-2"}), 71);            // sRGB(0.0625)
+  int filmic = centre({"--tonemap", "filmic"});
+  EXPECT_GT(filmic, 64);
+  EXPECT_LT(filmic, 137);
+  // The stats name what was applied.
+  CliResult r = run({"render", "s.ray", "-o", "o.exr", "--width", "8", "-q", "--exposure", "3", "--stats", "s.json"},
+                    dir.path());
+  ASSERT_EQ(r.status, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(slurp(dir.file("s.json")));
+  EXPECT_EQ(j["tonemap"], "srgb");
+  EXPECT_EQ(j["exposure"].get<double>(), 3.0);
+  // Bad values: a usage error, no image.
+  for (std::vector<std::string> bad : {std::vector<std::string>{"--tonemap", "aces"}, {"--exposure", "100"},
+                                       {"--exposure", "nan"}}) {
+    CliResult b = run({"render", "s.ray", "-o", "bad.png", "--width", "8", "-q", bad[0], bad[1]}, dir.path());
+    EXPECT_NE(b.status, 0) << bad[1];
+    EXPECT_NE(b.err.find(bad[0]), std::string::npos) << b.err;
+    EXPECT_FALSE(fs::exists(dir.file("bad.png")));
+  }
+}
+
+// PNG tEXt chunks (read back with the PNG chunk walker's independent copy below) and EXR
+// attributes (checked in io's tests) name the scene, the command line and the version.
+TEST(CliOutput, PngCarriesSceneCommandLineAndVersion) {
+  TempDir dir;
+  writeText(dir.file("my scene.ray"), kHeader + kLitFloor + "point_light { position = (2,4,3); }\n");
+  CliResult r = run({"render", "my scene.ray", "-o", "out.png", "--width", "16", "-q", "--exposure", "0.5"},
+                    dir.path());
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::string png = slurp(dir.file("out.png"));
+  std::vector<std::pair<std::string, std::string>> text;
+  for (size_t at = 8; at + 12 <= png.size();) {
+    uint32_t len = uint32_t(uint8_t(png[at])) << 24 | uint32_t(uint8_t(png[at + 1])) << 16 |
+                   uint32_t(uint8_t(png[at + 2])) << 8 | uint32_t(uint8_t(png[at + 3]));
+    if (png.compare(at + 4, 4, "tEXt") == 0) {
+      std::string body = png.substr(at + 8, len);
+      text.emplace_back(body.substr(0, body.find('\0')), body.substr(body.find('\0') + 1));
+    }
+    at += 12 + len;
+  }
+  CliResult v = run({"--version"}, dir.path());
+  ASSERT_FALSE(v.out.empty());
+  std::vector<std::pair<std::string, std::string>> want = {
+      {"Software", v.out.substr(0, v.out.size() - 1)},
+      {"Scene", "my scene.ray"},
+      {"Command line", "lightcuts render 'my scene.ray' -o out.png --width 16 -q --exposure 0.5"},
+      {"Tone map", "srgb"},
+      {"Exposure", "0.5"}};
+  EXPECT_EQ(text, want);
+}
+
+// The OBJ default camera fits the model's bounding sphere vertically; a portrait image widens
+// the view to fit it across too, so a cube keeps black margins left and right.
+TEST(CliObjCamera, PortraitImageKeepsTheModelInFrame) {
+  TempDir dir;
+  writeText(dir.file("cube.obj"),
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+            "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n");
+  auto columns = [&](int w, int h) {
+    CliResult r = run({"render", "cube.obj", "-o", "c.ppm", "--width", std::to_string(w), "--height",
+                       std::to_string(h), "-q"},
+                      dir.path());
+    EXPECT_EQ(r.status, 0) << r.err;
+    std::string ppm = slurp(dir.file("c.ppm"));
+    std::string header = "P6\n" + std::to_string(w) + " " + std::to_string(h) + "\n255\n";
+    EXPECT_EQ(ppm.rfind(header, 0), 0u);
+    // Brightest value in the left and right columns, and in the middle one.
+    int edge = 0, middle = 0;
+    for (int y = 0; y < h; ++y)
+      for (int c = 0; c < 3; ++c) {
+        auto at = [&](int x) { return int(uint8_t(ppm[header.size() + 3 * (size_t(y) * w + x) + c])); };
+        edge = std::max({edge, at(0), at(w - 1)});
+        middle = std::max(middle, at(w / 2));
+      }
+    return std::pair{edge, middle};
+  };
+  for (auto [w, h] : {std::pair{24, 48}, std::pair{48, 48}, std::pair{48, 24}}) {
+    auto [edge, middle] = columns(w, h);
+    EXPECT_EQ(edge, 0) << w << "x" << h;
+    EXPECT_GT(middle, 50) << w << "x" << h;
+  }
+}
+
+// compare: 8-bit inputs hold display-encoded values, and the command says so; EXR is linear.
+TEST(CliWarnings, CompareOf8BitImagesSaysTheyAreDisplayEncoded) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + kLitFloor + "point_light { position = (2,4,3); }\n");
+  for (const char* out : {"a.png", "a.exr"}) {
+    CliResult r = run({"render", "s.ray", "-o", out, "--width", "16", "-q"}, dir.path());
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  CliResult png = run({"compare", "a.png", "a.png"}, dir.path());
+  EXPECT_EQ(png.status, 0) << png.err;
+  EXPECT_EQ(notes(png.err), std::vector<std::string>{
+                                "lightcuts: warning: 'a.png' is an 8-bit image: its values are display-encoded (sRGB "
+                                "unless rendered with --tonemap clamp), so the errors are not relative errors of "
+                                "radiance; compare .exr renders for those"});
+  CliResult exr = run({"compare", "a.exr", "a.exr"}, dir.path());
+  EXPECT_EQ(exr.status, 0) << exr.err;
+  EXPECT_EQ(exr.err, "");
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <string>
 
 namespace lc::app {
 
@@ -14,5 +15,9 @@ void addSkyCommand(CLI::App& app);
 
 // Exit status of the subcommand that ran (set by its callback).
 int& exitStatus();
+
+// The command line as given ("lightcuts render scene.ray -o 'my out.png'", arguments
+// shell-quoted where needed), set by main() for the images' metadata.
+std::string& commandLine();
 
 }  // namespace lc::app

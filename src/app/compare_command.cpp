@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "app/commands.h"
+#include "app/warnings.h"
 #include "core/file_util.h"
 #include "io/colormap.h"
 #include "io/image.h"
@@ -29,6 +30,14 @@ int runCompare(const CompareArgs& a) {
   if (!a.heatmap.empty()) checkWritable(a.heatmap);
   io::Image ref = io::readImage(a.ref), test = io::readImage(a.test);
   io::ImageMetrics m = io::compareImages(ref, test, a.threshold);
+  // 8-bit files hold display-encoded values (render's default --tonemap srgb), not radiance.
+  for (const std::string* p : {&a.ref, &a.test})
+    if (fileExtension(*p) != "exr") {
+      printWarning(quoteInput(*p) + " is an 8-bit image: its values are display-encoded (sRGB unless rendered "
+                   "with --tonemap clamp), so the errors are not relative errors of radiance; compare .exr renders "
+                   "for those");
+      break;
+    }
   if (!a.heatmap.empty()) {
     io::Image hm = io::heatmap(io::relativeErrors(ref, test), ref.width, ref.height, 0, a.heatmapMax,
                                fmt::format("relative error (0 .. {:g})", a.heatmapMax));
@@ -55,7 +64,10 @@ int runCompare(const CompareArgs& a) {
 void addCompareCommand(CLI::App& app) {
   auto a = std::make_shared<CompareArgs>();
   CLI::App* c = app.add_subcommand("compare", "Error metrics of TEST against the reference REF (RMSE, relative errors, PSNR)");
-  c->add_option("ref", a->ref, "Reference image (.exr for exact values, or 8-bit)")->required();
+  c->add_option("ref", a->ref,
+                "Reference image: .exr (linear, exact) or 8-bit (compared as stored, i.e. display-encoded; a warning "
+                "says so)")
+      ->required();
   c->add_option("test", a->test, "Test image, same size")->required();
   c->add_flag("--json", a->json, "Print the metrics as JSON");
   c->add_option("--heatmap", a->heatmap, "Write the per-pixel relative error, colour-mapped with a legend, to this PNG");

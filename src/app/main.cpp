@@ -2,8 +2,12 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <cctype>
+#include <cstring>
+#include <string>
 
 #include "app/commands.h"
+#include "app/warnings.h"
 #include "core/error.h"
 
 namespace lc::app {
@@ -11,6 +15,21 @@ int& exitStatus() {
   static int status = 0;
   return status;
 }
+std::string& commandLine() {
+  static std::string line;
+  return line;
+}
+
+namespace {
+std::string shellQuote(const std::string& arg) {
+  bool plain = !arg.empty();
+  for (unsigned char c : arg) plain = plain && (std::isalnum(c) || std::strchr("_./=:,+-@%", c));
+  if (plain) return arg;
+  std::string q = "'";
+  for (char c : arg) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+}  // namespace
 }  // namespace lc::app
 
 int main(int argc, char** argv) {
@@ -18,7 +37,12 @@ int main(int argc, char** argv) {
                "with Lightcuts (Walter et al. 2005), the course project's cuts, or brute force"};
   // At most one subcommand; none prints the help (below).
   app.require_subcommand(0, 1);
-  app.set_version_flag("--version", "lightcuts 0.1.0");
+  app.set_version_flag("--version", "lightcuts " LC_VERSION);
+  // --help-all: every subcommand's options too (the man page is made from it).
+  app.set_help_all_flag("--help-all", "Print this help with every subcommand's options, and exit");
+  std::string& line = lc::app::commandLine();
+  line = "lightcuts";
+  for (int i = 1; i < argc; ++i) line += " " + lc::app::shellQuote(argv[i]);
   lc::app::addRenderCommand(app);
   lc::app::addInfoCommand(app);
   lc::app::addCompareCommand(app);
@@ -33,6 +57,8 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const lc::Error& e) {
     fmt::print(stderr, "lightcuts: {}\n", e.what());
+    std::string hint = lc::app::hintForError(e.bare());
+    if (!hint.empty()) lc::app::printHint(hint);
     return 1;
   } catch (const std::bad_alloc&) {
     fmt::print(stderr, "lightcuts: out of memory\n");

@@ -15,6 +15,7 @@
 #include "app/scene_loader.h"
 #include "app/scene_options.h"
 #include "app/summary.h"
+#include "app/warnings.h"
 #include "core/file_util.h"
 #include "core/memory_budget.h"
 #include "io/colormap.h"
@@ -50,7 +51,8 @@ struct RenderArgs {
   int referencePixels = 0;
   std::string reconstruct = "auto";
   std::string reconstructCoarse = "auto";
-  std::string tonemap = "clamp";
+  std::string tonemap = "srgb";
+  float exposure = 0;  // EV: 8-bit outputs scale linear values by 2^exposure
   uint64_t seed = 1;
   LoadOptions load;
 };
@@ -93,6 +95,11 @@ int reconstructCoarseSpacing(const std::string& option, int spacing) {
   return c;
 }
 
+// Text metadata of the output image: what made it and from what.
+io::TextMetadata metadata(const RenderArgs& a) {
+  return {{"Software", "lightcuts " LC_VERSION}, {"Scene", a.scene}, {"Command line", commandLine()}};
+}
+
 std::string defaultOutput(const std::string& scene) {
   std::string stem = scene;
   size_t slash = stem.find_last_of('/');
@@ -124,13 +131,16 @@ int runRender(RenderArgs& a) {
   tb.seed = a.seed;
   float error = a.error >= 0 ? a.error : (method == lightcuts::Method::Seed ? kSeedDefaultError : kLightcutsDefaultError);
   if (!std::isfinite(error)) throw Error("--error must be a finite number >= 0");
-  io::ToneMap tonemap = a.tonemap == "srgb" ? io::ToneMap::Srgb : io::ToneMap::Clamp;
+  io::ToneMap tonemap = io::parseToneMap(a.tonemap);
+  if (!std::isfinite(a.exposure)) throw Error("--exposure must be a finite number");
 
   a.load.threads = a.threads;
   a.load.objectLights.seed = a.seed;  // shifts the stratified object-light points
   a.load.envSeed = a.seed;            // shifts the environment lights' point set
-  // sRGB texture maps (from MTL files) are linearised only for a physically based output.
-  a.load.linearizeSrgbTextures = tonemap == io::ToneMap::Srgb;
+  // sRGB texture maps (from MTL files) are linearised whenever the output is display-encoded
+  // (srgb, filmic; the EXR of such a render too, so that both formats hold one linear image);
+  // --tonemap clamp keeps the course renderer's look: textures and output as stored.
+  a.load.linearizeSrgbTextures = tonemap != io::ToneMap::Clamp;
   a.load.quiet = a.quiet;
   a.load.interruptible = true;
   LoadedScene ls;
@@ -142,7 +152,8 @@ int runRender(RenderArgs& a) {
     return interruptExitStatus();
   }
   scene::Scene& scene = *ls.scene;
-  for (const std::string& w : ls.warnings) fmt::print(stderr, "warning: {}\n", w);
+  // The loader's warnings carry their location: "file:line:col: warning: ...".
+  for (const std::string& w : ls.warnings) fmt::print(stderr, "lightcuts: {}\n", w);
   if (!ls.objDescription.empty() && !a.quiet)
     fmt::print(stderr, "OBJ input: added a default camera and lights:\n{}\n", ls.objDescription);
 
@@ -168,7 +179,22 @@ int runRender(RenderArgs& a) {
                             a.load.limits.maxImagePixels));
   processBudget().reserve(uint64_t(a.width) * uint64_t(a.height) * memory_cost::kPixel,
                           fmt::format("the {}x{} image's buffers", a.width, a.height));
-  scene.setCamera(scene::Camera::fromDesc(cam, float(a.width) / float(a.height)));
+  io::CameraDesc camera = cam;
+  if (!ls.objDescription.empty() && a.width < a.height) {
+    // The OBJ default camera fits the model's bounding sphere in its vertical field of view;
+    // a portrait image would cut the sides, so the field is widened to fit it across instead.
+    float half = std::tan(camera.fovDegrees * kPi / 360.0f) * float(a.height) / float(a.width);
+    camera.fovDegrees = std::atan(half) * 360.0f / kPi;
+  }
+  scene.setCamera(scene::Camera::fromDesc(camera, float(a.width) / float(a.height)));
+  // (after the checks above: an error is not preceded by warnings about a render that will not run)
+  if (scene.lights().size() == 0)
+    printWarning("the scene has no lights: only emissive and ambient colours will show (add a point_light, "
+                 "directional_light, spot_light or area_light, or a luminosity to a material)");
+  const bool objInput = fileExtension(a.scene) == "obj";
+  if (objInput && !ls.objectLights.empty() && ls.vpls.vpls == 0 && a.load.gi && !a.load.vplCount)
+    printHint("the OBJ's emissive materials light what they see directly, nothing bounces; --vpls 10000 adds "
+              "indirect light (global illumination)");
 
   // Light tree and evaluator; oriented lights weigh their normal cones by the scene's size.
   tb.sceneDiagonal = scene.bounds().diagonal();
@@ -211,12 +237,29 @@ int runRender(RenderArgs& a) {
   if (rr.interrupted || interruptFlag().load()) {
     // Leave the requested output alone; keep what was rendered in OUT.partial.exr.
     std::string partial = a.out + ".partial.exr";
-    io::writeImage(partial, rr.image);
+    io::WriteOptions po;
+    po.metadata = metadata(a);
+    io::writeImage(partial, rr.image, po);
     fmt::print(stderr, "lightcuts: interrupted; {} untouched, partial image in {}\n", a.out, partial);
     return interruptExitStatus();
   }
 
-  io::writeImage(a.out, rr.image, tonemap);
+  io::WriteOptions wo;
+  wo.tonemap = tonemap;
+  wo.exposure = a.exposure;
+  wo.metadata = metadata(a);
+  if (ext != "exr") {
+    wo.metadata.emplace_back("Tone map", a.tonemap);
+    wo.metadata.emplace_back("Exposure", fmt::format("{:g}", a.exposure));
+  }
+  io::writeImage(a.out, rr.image, wo);
+  if (scene.lights().size() > 0) {
+    // Judged as displayed: the 8-bit output's tone map, or sRGB for an EXR viewed as usual.
+    const auto& es = rr.stats.eval;
+    RenderFacts facts{scene.lights().size(), rr.stats.primaryRays, es.shadingPoints, es.shadowRays, es.occludedRays};
+    std::string w = blackImageWarning(rr.image, ext == "exr" ? io::ToneMap::Srgb : tonemap, a.exposure, facts);
+    if (!w.empty()) printWarning(w);
+  }
   if (!a.cutHeatmap.empty()) {
     float maxCut = 1;
     for (float c : rr.cutSize) maxCut = std::max(maxCut, c);
@@ -259,6 +302,8 @@ int runRender(RenderArgs& a) {
     j["reconstruction_fallbacks"] = rr.stats.reconstructionFallbacks;
     j["reconstruction_coarse_cells"] = rr.stats.reconstructionCoarseCells;
     j["max_depth"] = a.maxDepth;
+    j["tonemap"] = a.tonemap;
+    j["exposure"] = a.exposure;
     j["time_total_s"] = total;
     j["time_load_s"] = ls.loadSeconds;
     j["time_accel_s"] = ls.accelSeconds;
@@ -394,8 +439,19 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--cut-heatmap", a->cutHeatmap,
                 "Write the per-pixel cut size, colour-mapped with a legend, to this PNG; default none")
       ->group(output);
-  c->add_option("--tonemap", a->tonemap, fmt::format("8-bit output: clamp (the course renderer's) or srgb; default {}", d.tonemap))
-      ->check(CLI::IsMember({"clamp", "srgb"}))
+  c->add_option("--tonemap", a->tonemap,
+                fmt::format("8-bit output (.png .ppm .bmp): srgb (the linear image sRGB-encoded for display), filmic "
+                            "(highlights roll off: Narkowicz's ACES fit, then sRGB) or clamp (values stored as they "
+                            "are, the course renderer's look; sRGB textures not linearised); .exr stays linear; "
+                            "default {}",
+                            d.tonemap))
+      ->check(CLI::IsMember({"clamp", "srgb", "filmic"}))
+      ->group(output);
+  c->add_option("--exposure", a->exposure,
+                fmt::format("Exposure in stops for 8-bit output: linear values are scaled by 2^EV before the tone "
+                            "map (.exr is written unscaled); default {:g}",
+                            d.exposure))
+      ->check(CLI::Range(-64.0f, 64.0f))
       ->group(output);
   c->add_flag("-q,--quiet", a->quiet, fmt::format("No progress bar or summary; default {}", d.quiet ? "on" : "off"))
       ->group(output);

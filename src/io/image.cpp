@@ -6,6 +6,7 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
 
@@ -24,6 +25,7 @@
 #include <vector>
 
 #include "core/file_util.h"
+#include "io/png_text.h"
 
 namespace lc::io {
 
@@ -47,10 +49,11 @@ void writeBytes(const std::string& tmp, const std::string& path, const std::vect
   if (writeErr != 0) throw Error("cannot write " + quoteInput(path) + ": " + std::strerror(writeErr));
 }
 
-std::vector<uint8_t> toBytes(const Image& img, ToneMap tonemap) {
+std::vector<uint8_t> toBytes(const Image& img, ToneMap tonemap, float exposure) {
   std::vector<uint8_t> out(img.pixels.size() * 3);
+  const float scale = std::exp2(exposure);
   for (size_t i = 0; i < img.pixels.size(); ++i)
-    for (int c = 0; c < 3; ++c) out[3 * i + size_t(c)] = quantize8(img.pixels[i][c], tonemap);
+    for (int c = 0; c < 3; ++c) out[3 * i + size_t(c)] = quantize8(img.pixels[i][c], tonemap, scale);
   return out;
 }
 
@@ -67,7 +70,7 @@ std::vector<uint8_t> encodePpm(const Image& img, const std::vector<uint8_t>& rgb
   return out;
 }
 
-void writeExr(const std::string& tmp, const std::string& path, const Image& img) {
+void writeExr(const std::string& tmp, const std::string& path, const Image& img, const TextMetadata& metadata) {
   // NaN -> 0 as in the 8-bit formats; infinities are kept (EXR can hold them).
   std::vector<Color> px(img.pixels);
   for (Color& c : px)
@@ -77,6 +80,7 @@ void writeExr(const std::string& tmp, const std::string& path, const Image& img)
     Imf::Header header(img.width, img.height);
     // 32-bit float channels: the round trip is exact (half would lose precision).
     for (const char* ch : {"R", "G", "B"}) header.channels().insert(ch, Imf::Channel(Imf::FLOAT));
+    for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
     Imf::FrameBuffer fb;
     const size_t xs = sizeof(Color), ys = sizeof(Color) * size_t(img.width);
     char* base = reinterpret_cast<char*>(px.data());
@@ -546,11 +550,34 @@ float linearToSrgb(float v) {
   return v <= 0.0031308f ? v * 12.92f : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
 
-uint8_t quantize8(float v, ToneMap tonemap) {
+uint8_t quantize8(float v, ToneMap tonemap, float scale) {
   if (std::isnan(v)) return 0;
+  v *= scale;
+  if (tonemap == ToneMap::Filmic) {
+    // Narkowicz 2015, "ACES Filmic Tone Mapping Curve", with his 0.6 pre-scale.
+    float x = std::max(0.0f, v) * 0.6f;
+    if (std::isinf(x)) return 255;
+    v = (x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f);
+  }
   v = std::clamp(v, 0.0f, 1.0f);
-  if (tonemap == ToneMap::Srgb) v = linearToSrgb(v);
+  if (tonemap != ToneMap::Clamp) v = linearToSrgb(v);
   return uint8_t(std::lround(v * 255.0f));
+}
+
+ToneMap parseToneMap(const std::string& name) {
+  if (name == "clamp") return ToneMap::Clamp;
+  if (name == "srgb") return ToneMap::Srgb;
+  if (name == "filmic") return ToneMap::Filmic;
+  throw Error("unknown tone map " + quoteInput(name) + " (use clamp, srgb or filmic)");
+}
+
+const char* toneMapName(ToneMap tonemap) {
+  switch (tonemap) {
+    case ToneMap::Clamp: return "clamp";
+    case ToneMap::Srgb: return "srgb";
+    case ToneMap::Filmic: return "filmic";
+  }
+  return "clamp";
 }
 
 bool isWritableImageExtension(const std::string& ext) {
@@ -558,7 +585,7 @@ bool isWritableImageExtension(const std::string& ext) {
   return e == "png" || e == "ppm" || e == "bmp" || e == "exr";
 }
 
-void writeImage(const std::string& path, const Image& image, ToneMap tonemap) {
+void writeImage(const std::string& path, const Image& image, const WriteOptions& options) {
   const std::string ext = fileExtension(path);
   if (!isWritableImageExtension(ext)) {
     if (ext.empty()) throw Error("cannot write " + quoteInput(path) + ": no image format extension " + kFormatsHint);
@@ -574,12 +601,12 @@ void writeImage(const std::string& path, const Image& image, ToneMap tonemap) {
                 std::to_string(image.width) + "x" + std::to_string(image.height));
 
   if (ext == "exr") {
-    writeFileAtomically(path, [&](const std::string& tmp) { writeExr(tmp, path, image); });
+    writeFileAtomically(path, [&](const std::string& tmp) { writeExr(tmp, path, image, options.metadata); });
     return;
   }
   // Encode in memory first so that file errors come from our own writes (with errno)
   // rather than from stb's silent 0 return.
-  std::vector<uint8_t> rgb = toBytes(image, tonemap);
+  std::vector<uint8_t> rgb = toBytes(image, options.tonemap, options.exposure);
   std::vector<uint8_t> encoded;
   if (ext == "ppm") {
     encoded = encodePpm(image, rgb);
@@ -589,6 +616,7 @@ void writeImage(const std::string& path, const Image& image, ToneMap tonemap) {
                           : stbi_write_bmp_to_func(appendToVector, &encoded, image.width, image.height, 3,
                                                    rgb.data());
     if (!ok) throw Error("cannot write " + quoteInput(path) + ": the " + ext + " encoder failed");
+    if (ext == "png" && !options.metadata.empty()) encoded = addPngText(encoded, options.metadata);
   }
   writeFileAtomically(path, [&](const std::string& tmp) { writeBytes(tmp, path, encoded); });
 }

@@ -1,10 +1,12 @@
-// Float RGB images and their file formats. 8-bit outputs (PNG, PPM, BMP) clamp linear
-// values to [0,1] as the course renderer did (or apply the sRGB curve with srgb = true);
-// EXR keeps linear floats. Every write is atomic (temporary file, then rename).
+// Float RGB images and their file formats. 8-bit outputs (PNG, PPM, BMP) store a display
+// encoding of the linear values (ToneMap: clamped as the course renderer did, the sRGB
+// curve, or a filmic curve then sRGB); EXR keeps linear floats. Every write is atomic
+// (temporary file, then rename).
 #pragma once
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -23,14 +25,35 @@ struct Image {
   const Color& at(int x, int y) const { return pixels[size_t(y) * size_t(width) + size_t(x)]; }
 };
 
-enum class ToneMap { Clamp, Srgb };
+// How a linear value v becomes an 8-bit one (after scaling by 2^exposure):
+//   Clamp:  round(clamp(v, 0, 1) * 255), the course renderer's look (values stored as they are);
+//   Srgb:   the sRGB OETF of clamp(v, 0, 1), what a display expects of a linear image;
+//   Filmic: Narkowicz's fit of the ACES filmic curve applied to 0.6 v (highlights roll off
+//           instead of clipping), then the sRGB OETF.
+enum class ToneMap { Clamp, Srgb, Filmic };
+
+using TextMetadata = std::vector<std::pair<std::string, std::string>>;  // (key, value)
+
+// What writeImage stores besides the pixels.
+struct WriteOptions {
+  ToneMap tonemap = ToneMap::Clamp;
+  float exposure = 0;  // 8-bit outputs: linear values are scaled by 2^exposure first
+  // Text metadata, (key, value): EXR string attributes, PNG tEXt chunks (iTXt when the
+  // value is not ASCII); PPM and BMP have no place for it. Keys are 1..79 printable ASCII
+  // characters.
+  TextMetadata metadata;
+};
 
 // Writes by extension: .png .ppm .bmp (8-bit) or .exr (float). Throws lc::Error
 // (unknown extension, unwritable path) and leaves any existing file untouched on failure.
-// 8-bit: Clamp stores round(clamp(v, 0, 1) * 255); Srgb applies the sRGB OETF to the
-// clamped value first. EXR stores 32-bit float RGB (exact round trip), tonemap ignored.
-// NaN channels are written as 0 in every format.
-void writeImage(const std::string& path, const Image& image, ToneMap tonemap = ToneMap::Clamp);
+// 8-bit: quantize8 of each channel. EXR stores 32-bit float RGB (exact round trip):
+// tonemap and exposure are ignored. NaN channels are written as 0 in every format.
+void writeImage(const std::string& path, const Image& image, const WriteOptions& options);
+inline void writeImage(const std::string& path, const Image& image, ToneMap tonemap = ToneMap::Clamp) {
+  WriteOptions o;
+  o.tonemap = tonemap;
+  writeImage(path, image, o);
+}
 
 // What went wrong in readImage, so that callers (textures) can reword the message and
 // add the location that referred to the file.
@@ -60,8 +83,12 @@ Image readImage(const std::string& path, bool srgb = false,
 float srgbToLinear(float v);
 float linearToSrgb(float v);
 
-// The 8-bit value writeImage stores for a linear channel value.
-uint8_t quantize8(float v, ToneMap tonemap);
+// The 8-bit value writeImage stores for a linear channel value (scale = 2^exposure).
+uint8_t quantize8(float v, ToneMap tonemap, float scale = 1);
+
+// ToneMap by name ("clamp", "srgb", "filmic") and back; parse throws lc::Error on others.
+ToneMap parseToneMap(const std::string& name);
+const char* toneMapName(ToneMap tonemap);
 
 // True for extensions writeImage accepts.
 bool isWritableImageExtension(const std::string& ext);

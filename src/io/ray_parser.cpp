@@ -335,7 +335,7 @@ TextureRef Parser::mapValue(const Token& mapKeyword) {
   TextureRef ref;
   ref.path = resolveRelative(baseDir_, f.text);
   ref.loc = lex_.loc(mapKeyword);
-  ref.srgb = false;  // .ray textures are read as value/255, like the course renderer
+  ref.srgb = false;  // scalar maps (shininess, index) are values; colour maps are marked below
   return ref;
 }
 
@@ -344,7 +344,11 @@ ColorParam Parser::colorValue() {
   const Token& t = lex_.peek();
   if (t.isWord("map")) {
     Token m = lex_.next();
-    return ColorParam{Color(0, 0, 0), mapValue(m)};
+    // An 8-bit colour map is sRGB-encoded: linearised for a display-encoded output (the
+    // default), read as value/255 like the course renderer under --tonemap clamp.
+    TextureRef ref = mapValue(m);
+    ref.srgb = true;
+    return ColorParam{Color(0, 0, 0), ref};
   }
   if (t.isPunct('(')) return ColorParam{vec3(), std::nullopt};
   expected("a colour (r,g,b) or map(\"file\")", lex_.next());

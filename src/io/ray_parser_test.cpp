@@ -363,8 +363,9 @@ TEST(RayParserMaterial, TextureMaps) {
   EXPECT_EQ(m.diffuse.map->loc.file, "t.ray");
   EXPECT_EQ(m.diffuse.map->loc.line, 3);
   EXPECT_EQ(m.diffuse.map->loc.column, 13);
-  EXPECT_FALSE(m.diffuse.map->srgb);
+  EXPECT_TRUE(m.diffuse.map->srgb);  // a colour map: sRGB (linearised for display-encoded output)
   ASSERT_TRUE(m.specular.map);
+  EXPECT_TRUE(m.specular.map->srgb);
   EXPECT_EQ(m.specular.map->path, "/base/specmap");
   ASSERT_TRUE(m.shininess.map);
   EXPECT_EQ(m.shininess.map->path, "/base/rough.png");
@@ -372,6 +373,8 @@ TEST(RayParserMaterial, TextureMaps) {
   EXPECT_EQ(m.shininess.map->loc.column, 15);
   ASSERT_TRUE(m.index.map);
   EXPECT_EQ(m.index.map->path, "/abs/ior.png");  // absolute paths are kept
+  EXPECT_FALSE(m.shininess.map->srgb);  // scalar maps are values
+  EXPECT_FALSE(m.index.map->srgb);
   // A relative base directory joins too; an empty one leaves the path as written.
   SceneDesc r = parseRayString(std::string(kHeader) + "box { material = { diffuse = map(\"a.bmp\"); }; }",
                                "x.ray", "scenes/sub", {});

@@ -18,8 +18,9 @@ namespace lc::io {
 struct TextureRef {
   std::string path;  // resolved against the referring file's directory
   SourceLoc loc;     // where it was referred to (for "missing texture" errors)
-  // true for 8-bit sRGB images that should be linearised under --tonemap srgb
-  // (OBJ/MTL inputs); .ray textures are read as values/255 like the course renderer.
+  // true for colour maps (8-bit sRGB images), linearised when the output is display-encoded
+  // (--tonemap srgb or filmic; scene::BuildOptions::linearizeSrgbTextures); false for scalar
+  // maps (shininess, index), read as values/255.
   bool srgb = false;
 };
 
