@@ -44,6 +44,7 @@ struct RenderArgs {
   std::string tree;  // default: by method
   float error = -1;  // default: by method
   int maxCut = 4000;
+  int stochasticCut = lightcuts::CutOptions{}.stochasticCut;
   std::string criterion = "total";
   std::string estimator = "first-order";
   std::string visibilityProbes = "on";
@@ -202,6 +203,8 @@ int runRender(RenderArgs& a) {
   std::unique_ptr<lightcuts::LightEvaluator> evaluator;
   lightcuts::CutOptions co{error, a.maxCut, lightcuts::parseCutCriterion(a.criterion),
                            lightcuts::parseEstimator(a.estimator), a.visibilityProbes == "on"};
+  co.stochasticCut = a.stochasticCut;
+  co.seed = a.seed;
   if (method == lightcuts::Method::Brute) {
     evaluator = lightcuts::makeBruteForce(scene.lights());
   } else {
@@ -209,8 +212,9 @@ int runRender(RenderArgs& a) {
     tb.progress = [&](double f) { bar.update(f); };
     forest = lightcuts::buildLightForest(scene.lights(), tb);
     bar.finish();
-    evaluator = method == lightcuts::Method::Seed ? lightcuts::makeSeedCuts(scene.lights(), forest, co)
-                                                  : lightcuts::makeLightcuts(scene.lights(), forest, co);
+    evaluator = method == lightcuts::Method::Seed         ? lightcuts::makeSeedCuts(scene.lights(), forest, co)
+                : method == lightcuts::Method::Stochastic ? lightcuts::makeStochasticLightcuts(scene.lights(), forest, co)
+                                                          : lightcuts::makeLightcuts(scene.lights(), forest, co);
   }
 
   render::RenderOptions ro;
@@ -483,9 +487,15 @@ void addRenderCommand(CLI::App& app) {
                                                "instant_radiosity's seed); default {}", d.seed))
       ->group(image);
   c->add_option("--method", a->method,
-                fmt::format("Direct lighting: lightcuts (Walter et al. 2005), seed (the course project's cuts) or "
-                            "brute; default {}", d.method))
-      ->check(CLI::IsMember({"lightcuts", "seed", "brute"}))
+                fmt::format("Direct lighting: lightcuts (Walter et al. 2005), seed (the course project's cuts), "
+                            "stochastic (stochastic lightcuts, Yuksel 2019: unbiased, noisy, no error bound; average "
+                            "with --spp) or brute; default {}", d.method))
+      ->check(CLI::IsMember({"lightcuts", "seed", "stochastic", "brute"}))
+      ->group(cuts);
+  c->add_option("--stochastic-cut", a->stochasticCut,
+                fmt::format("--method stochastic: clusters per shading point, one light drawn in each; default {}",
+                            lightcuts::CutOptions{}.stochasticCut))
+      ->check(CLI::Range(1, 1 << 20))
       ->group(cuts);
   c->add_option("--tree", a->tree,
                 fmt::format("Light tree: walter (agglomerative) or seed (k-d split); default {} for --method seed, "

@@ -13,7 +13,8 @@ Method parseMethod(const std::string& name) {
   if (name == "brute") return Method::Brute;
   if (name == "lightcuts") return Method::Lightcuts;
   if (name == "seed") return Method::Seed;
-  throw Error("unknown method '" + name + "' (use brute, lightcuts or seed)");
+  if (name == "stochastic") return Method::Stochastic;
+  throw Error("unknown method '" + name + "' (use brute, lightcuts, seed or stochastic)");
 }
 
 const char* methodName(Method m) {
@@ -21,6 +22,7 @@ const char* methodName(Method m) {
     case Method::Brute: return "brute";
     case Method::Lightcuts: return "lightcuts";
     case Method::Seed: return "seed";
+    case Method::Stochastic: return "stochastic";
   }
   return "?";
 }

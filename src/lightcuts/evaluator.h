@@ -29,8 +29,9 @@
 
 namespace lc::lightcuts {
 
-enum class Method { Brute, Lightcuts, Seed };
-Method parseMethod(const std::string& name);  // "brute" | "lightcuts" | "seed"
+// Stochastic: stochastic lightcuts (stochastic.cpp), unbiased and noisy.
+enum class Method { Brute, Lightcuts, Seed, Stochastic };
+Method parseMethod(const std::string& name);  // "brute" | "lightcuts" | "seed" | "stochastic"
 const char* methodName(Method m);
 
 // When a cut is good enough.
@@ -59,6 +60,10 @@ struct CutOptions {
   // cluster is provably hidden (Visibility::trace) and stays in the cut as 0, with no
   // error, instead of being refined down to every light (the umbra of an emitter).
   bool visibilityProbes = true;
+  // --method stochastic: clusters in the cut, each giving one light drawn at random
+  // (stochastic.cpp); its seed (render --seed).
+  int stochasticCut = 64;
+  uint64_t seed = 1;
 };
 
 struct EvalResult {
@@ -101,5 +106,7 @@ std::unique_ptr<LightEvaluator> makeLightcuts(const LightSet& lights, const Ligh
                                               const CutOptions& options);
 std::unique_ptr<LightEvaluator> makeSeedCuts(const LightSet& lights, const LightForest& forest,
                                              const CutOptions& options);
+std::unique_ptr<LightEvaluator> makeStochasticLightcuts(const LightSet& lights, const LightForest& forest,
+                                                        const CutOptions& options);
 
 }  // namespace lc::lightcuts
