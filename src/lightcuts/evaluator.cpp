@@ -353,7 +353,7 @@ class Lightcuts final : public LightEvaluator {
       const CutNode& cn = nodes[uint32_t(key)];
       float factor = 1;
       const LightTree& ctree = forest_.trees[cn.tree];
-      if (firstOrder && !cn.firstOrder && ctree.type == LightType::Directional &&
+      if (firstOrder && !cn.firstOrder && cn.lower <= 0 && ctree.type == LightType::Directional &&
           ctree.lightCount(cn.node) <= kExactSumMaxLights && cn.shadow.found != CutVisibility::Occluded &&
           cn.shadow.found != CutVisibility::Partial) {
         // A small environment cluster across the surface's horizon (or with a specular
