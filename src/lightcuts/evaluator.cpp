@@ -356,9 +356,9 @@ class Lightcuts final : public LightEvaluator {
       if (firstOrder && !cn.firstOrder && cn.lower <= 0 && ctree.type == LightType::Directional &&
           ctree.lightCount(cn.node) <= kExactSumMaxLights && cn.shadow.found != CutVisibility::Occluded &&
           cn.shadow.found != CutVisibility::Partial) {
-        // A small environment cluster across the surface's horizon (or with a specular
-        // lobe's edge): its exact unshadowed sum, times the visibility of its representative
-        // or, when that one is behind the surface, of its brightest light.
+        // A small environment cluster across the surface's horizon (no lower bound): its
+        // exact unshadowed sum, times the visibility of its representative or, when that one
+        // is behind the surface, of its brightest light.
         Color exact = exactDirectionalSum(ctree, cn.node, sp, vis, stats, cn.shadow.found);
         float raw = luminance(cn.estimate), le = luminance(exact);
         total += exact;
