@@ -99,11 +99,39 @@ struct RotatedBox {
   }
 };
 
+// Bounds of the cosine between `target` and the unit vectors of a directional cluster,
+// each with a little slack (see clusterBounds). The box holds unit vectors, whose cosine to
+// the frame's axis is their z coordinate: within [cz - hz, cz + hz], and at most
+// sqrt(1 - x^2 - y^2) (the box's general bounds divide by the vectors' lengths instead,
+// looser for vectors known to be unit). And the node's cone (computeDirectionCones): the
+// lights' travel directions lie within its half-angle of `axis`, so the directions toward
+// them within it of -axis: the cosine is within cos(theta -+ beta), theta the angle from
+// -axis to the target. A cone bounds a round patch of the sphere more tightly than its box
+// once turned into the frame; each bound takes the better of the two.
+struct CosRange {
+  float up, lo;
+};
+inline CosRange unitCosBounds(const RotatedBox& b, const Vec3& target, const LightNode& node, float slack) {
+  float ax = std::fabs(b.cx) - b.hx, ay = std::fabs(b.cy) - b.hy;
+  float x2 = ax > 0 ? ax * ax : 0, y2 = ay > 0 ? ay * ay : 0;
+  // 1 - x^2 - y^2 cancels near the horizon (z ~ 0): 2e-6 covers its float rounding.
+  float up = std::min(b.cz + b.hz, std::sqrt(std::max(0.0f, 1 - x2 - y2) + 2e-6f));
+  float lo = b.cz - b.hz;
+  if (node.cosHalfAngle > -1) {
+    const float cb = node.cosHalfAngle, sb = std::sqrt(std::max(0.0f, 1 - cb * cb));
+    const float c = -dot(target, node.axis);
+    up = std::min(up, coneWiden(c, cb, sb));
+    lo = std::max(lo, coneNarrow(c, cb, sb));
+  }
+  return {up + slack, lo - slack};
+}
+
 // Upper bound (RGB) of the sum of the unshadowed contributions of the node's lights and,
 // when `lower` is given, a lower bound: with visibility 1 the cluster gives something in
 // [lower, upper], so upper - lower bounds the error of an unoccluded cluster's estimate.
 // `smooth` (with `lower`) tells whether every light's contribution is a smooth function
-// of its position and normal over the cluster: omni or oriented lights, every cosine
+// of its position and normal over the cluster: omni, oriented or directional lights (of
+// their direction), every cosine
 // bounded away from 0 (no clamp at the horizon) and no corner of the attenuation's clamp
 // between the nearest and farthest light. Only then is the first-order estimate
 // (estimate.h) valid.
@@ -123,23 +151,41 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
     hi = node.hi - sp.p;
   }
   Vec3 c = (lo + hi) * 0.5f, h = (hi - lo) * 0.5f;
+  const bool directional = type == LightType::Directional;
   RotatedBox bn(fr.n, c, h);
   float cN = bn.cosUpper();
   if (cN <= 0) return Color(0);  // every light is behind the surface
+  CosRange un{1, 0};
+  if (directional) {
+    un = unitCosBounds(bn, fr.n.w, node, kSlack);
+    cN = std::min(cN, un.up);
+    if (cN <= 0) return Color(0);
+  }
   // Nearest and farthest vectors of the box: |q| lies in [dMin, dMax] for all of them.
   float dMax = length(vmax(vabs(lo), vabs(hi)));
   float dMin = std::sqrt(dot(vmax(vmax(lo, -hi), Vec3(0.0f)), vmax(vmax(lo, -hi), Vec3(0.0f))));
   // Lower cosine bounds: the smallest projection over the longest vector. Lights that may
   // be behind the surface give nothing at all, so no lower bound then (specular neither).
   float cNLo = lower && dMax > 0 ? std::max(0.0f, (bn.cz - bn.hz) / dMax) : 0.0f;
+  if (lower && directional) cNLo = std::max(cNLo, un.lo);
   bool specular = !g.diffuseOnly && sp.hasSpecular();
   Color mUp = sp.kd * std::min(1.0f, cN + kSlack);
   Color mLo = sp.kd * cNLo;
-  bool sm = lower && cNLo > 0 && (type == LightType::Omni || type == LightType::Oriented);
+  // Smooth: the first-order estimate applies (directional: its gradient is over the
+  // directions, estimate.h).
+  bool sm = lower && cNLo > 0 &&
+            (type == LightType::Omni || type == LightType::Oriented || directional);
   if (specular) {
     RotatedBox br(fr.r, c, h);
-    mUp += sp.ks * powNonNegative(std::min(1.0f, br.cosUpper() + kSlack), sp.shininess);
+    float cRUp = br.cosUpper();
+    CosRange ur{1, 0};
+    if (directional && cRUp > 0) {
+      ur = unitCosBounds(br, fr.r.w, node, kSlack);
+      cRUp = std::max(0.0f, std::min(cRUp, ur.up));
+    }
+    mUp += sp.ks * powNonNegative(std::min(1.0f, cRUp + kSlack), sp.shininess);
     float cRLo = cNLo > 0 ? std::max(0.0f, (br.cz - br.hz) / dMax) : 0.0f;
+    if (cNLo > 0 && directional) cRLo = std::max(cRLo, ur.lo);
     if (cNLo > 0) mLo += sp.ks * powNonNegative(cRLo, sp.shininess);
     sm = sm && cRLo > 0;
   }
@@ -175,7 +221,7 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
     }
   }
   if (lower) *lower = mLo * (gLo * 0.9999f) * node.intensity;
-  if (smooth) *smooth = sm && type != LightType::Directional;
+  if (smooth) *smooth = sm;
   // A little slack so float rounding never puts the bound below an exact value.
   return mUp * (gUp * 1.0001f) * node.intensity;
 }

@@ -36,11 +36,28 @@ const char* estimatorName(Estimator e);
 // whose expectation over the representative's choice (probability proportional to
 // intensity) is the cluster's mean of f to second order: no bias is added. (The gradient
 // at x_j instead would leave -(1/2) d^T H d, the same sign for every cluster: errors that
-// add up over a cut instead of cancelling.) Per unit intensity and unshadowed, omni and
-// oriented lights; `unit` is lightContribution()'s value for `rep` (M * G).
+// add up over a cut instead of cancelling.) Per unit intensity and unshadowed, omni,
+// oriented and directional lights; `unit` is lightContribution()'s value for `rep` (M * G).
+//
+// Directional lights (environments): f is a function of the unit direction w toward the
+// light, extended to all vectors as f(w) = kd N.w + ks (R.w)^s, and the cluster's mean
+// direction m (NodeMoments::centroid, |m| <= 1) is where its gradient is taken:
+//   f(w_j) - grad f(m) . (w_j - m).
+// The diffuse term is linear in w, so for it this is kd N.m, the cluster's exact mean
+// (in luminance: the moments are luminance-weighted), whichever light represents it; the
+// specular term keeps a second-order error (and none at shininess 1).
 inline Color firstOrderUnit(const Light& rep, const LightGroup& g, const ShadingPoint& sp, const NodeMoments& m,
                             const Color& unit) {
   if (isBlack(unit)) return unit;
+  if (rep.type == LightType::Directional) {
+    Vec3 dw = -rep.direction - m.centroid;  // the representative's direction less the mean
+    Color dMat = sp.kd * dot(sp.n, dw);
+    if (!g.diffuseOnly && sp.hasSpecular() && sp.shininess > 0) {
+      float cR = dot(sp.r, m.centroid);
+      if (cR > 0) dMat += sp.ks * (sp.shininess * powNonNegative(cR, sp.shininess - 1) * dot(sp.r, dw));
+    }
+    return unit - dMat;
+  }
   Vec3 d = m.centroid - sp.p;
   float r = length(d);
   if (!(r > 0)) return unit;

@@ -72,6 +72,13 @@ constexpr double kSmoothSpreadMin = 0.5;
 // more than refining a small cluster does.
 constexpr uint32_t kProbeMinLights = 16;
 
+// Directional clusters of at most this many lights that end in a cut without a first-order
+// estimate (an environment cluster across a surface's horizon, where the clamped cosine is
+// not smooth) are estimated by their exact unshadowed sum (a walk over their lights, no
+// rays) times one visibility: the representative's is a 0-or-everything sample there, the
+// error the white furnace showed at the default --error (docs/LIGHTCUTS.md).
+constexpr uint32_t kExactSumMaxLights = 64;
+
 // What a representative's shadow ray found (recorded for reconstruction cuts) and, when
 // asked for, what stopped it (for the visibility probes).
 struct ShadowResult {
@@ -347,7 +354,19 @@ class Lightcuts final : public LightEvaluator {
     for (uint64_t key : heap) {
       const CutNode& cn = nodes[uint32_t(key)];
       float factor = 1;
-      if (cn.firstOrder) {
+      const LightTree& ctree = forest_.trees[cn.tree];
+      if (firstOrder && !cn.firstOrder && cn.lower <= 0 && ctree.type == LightType::Directional &&
+          ctree.lightCount(cn.node) <= kExactSumMaxLights && cn.shadow.found != CutVisibility::Occluded &&
+          cn.shadow.found != CutVisibility::Partial) {
+        // A small environment cluster across the surface's horizon (no lower bound): its
+        // exact unshadowed sum, times the visibility of its representative or, when that one
+        // is behind the surface, of its brightest light.
+        Color exact = exactDirectionalSum(ctree, cn.node, sp, vis, stats, cn.shadow.found);
+        float raw = luminance(cn.estimate), le = luminance(exact);
+        total += exact;
+        total -= cn.estimate;
+        if (raw > 0 && le > 0) factor = std::clamp(le / raw, 0.5f, 2.0f);
+      } else if (cn.firstOrder) {
         const LightTree& tree = forest_.trees[cn.tree];
         const LightNode& n = tree.nodes[cn.node];
         Color fo = vmax(firstOrderUnit(lights_.lights[n.rep], lights_.groups[tree.group], sp, tree.momentsOf(lights_, cn.node),
@@ -387,6 +406,44 @@ class Lightcuts final : public LightEvaluator {
   Method method() const override { return Method::Lightcuts; }
 
  private:
+  // The unshadowed sum of a directional cluster's lights at sp, times a visibility: 1 when
+  // its representative was found visible (`found`), else (the representative is behind the
+  // surface and cast no ray) that of its brightest light, one shadow ray.
+  Color exactDirectionalSum(const LightTree& tree, uint32_t node, const ShadingPoint& sp, Visibility& vis,
+                            EvalStats& stats, CutVisibility found) const {
+    const LightGroup& g = lights_.groups[tree.group];
+    static thread_local std::vector<uint32_t> stack;
+    stack.assign(1, node);
+    Vec3d sum;
+    float brightest = 0;
+    Vec3 brightestDir;
+    while (!stack.empty()) {
+      const LightNode& n = tree.nodes[stack.back()];
+      stack.pop_back();
+      if (!n.isLeaf()) {
+        stack.push_back(n.left);
+        stack.push_back(n.left + 1);
+        continue;
+      }
+      Color mg;
+      Vec3 wi;
+      float dist;
+      if (!lightContribution(lights_.lights[n.rep], g, sp, mg, wi, dist)) continue;
+      Color c = mg * n.intensity;
+      sum += c;
+      if (luminance(c) > brightest) {
+        brightest = luminance(c);
+        brightestDir = wi;
+      }
+    }
+    Color exact = sum.toFloat();
+    if (found == CutVisibility::Visible || !(brightest > 0)) return exact;
+    ++stats.shadowRays;
+    Color v = vis(brightestDir, kInf);
+    stats.occludedRays += isBlack(v);
+    return exact * v;
+  }
+
   // Whether the whole cluster is provably hidden from sp: its representative's shadow ray
   // (`rep`) and those toward the corners of its bounding box all meet one convex opaque
   // object, nearer than the box. The directions whose ray meets a convex object within a

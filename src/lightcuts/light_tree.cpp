@@ -2,6 +2,7 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -265,6 +266,59 @@ void computePreorder(LightTree& tree) {
   }
 }
 
+void computeDirectionCones(const LightSet& lights, LightTree& tree) {
+  // Bottom-up in double: each inner node's cone is the smallest cone holding its children's
+  // (as coneUnion), so a node's cone holds every light below it. A float cosine cannot
+  // tell half-angles below ~3.5e-4 apart (cos rounds to 1), so each node stores
+  // cos(half-angle + kMargin), rounded down: the angle it stands for is never too small.
+  constexpr double kMargin = 1e-3;
+  const size_t n = tree.nodes.size();
+  std::vector<Vec3d> axis(n);
+  std::vector<double> angle(n);
+  auto unit = [](const Vec3d& v) {
+    double l = std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    return l > 0 ? v / l : Vec3d(0, 0, 1);
+  };
+  auto dotd = [](const Vec3d& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; };
+  for (size_t i = n; i-- > 0;) {
+    LightNode& nd = tree.nodes[i];
+    if (nd.isLeaf()) {
+      axis[i] = unit(Vec3d(lights.lights[nd.rep].direction));
+      angle[i] = 0;
+    } else {
+      const Vec3d a = axis[nd.left], b = axis[nd.left + 1];
+      const double ta = angle[nd.left], tb = angle[nd.left + 1];
+      const double ab = std::clamp(dotd(a, b), -1.0, 1.0), td = std::acos(ab);
+      if (ta >= kPi || tb >= kPi) {
+        axis[i] = a;
+        angle[i] = kPi;
+      } else if (td + tb <= ta) {
+        axis[i] = a;
+        angle[i] = ta;
+      } else if (td + ta <= tb) {
+        axis[i] = b;
+        angle[i] = tb;
+      } else {
+        const double to = (ta + td + tb) * 0.5;
+        Vec3d t = b - a * ab;  // toward b, orthogonal to a
+        double tl = std::sqrt(dotd(t, t));
+        if (to >= kPi || !(tl > 1e-12)) {
+          axis[i] = a;
+          angle[i] = kPi;
+        } else {
+          const double phi = to - ta;  // rotate a toward b by this much
+          axis[i] = unit(a * std::cos(phi) + t * (std::sin(phi) / tl));
+          angle[i] = to;
+        }
+      }
+    }
+    const double widened = angle[i] + kMargin;
+    nd.axis = axis[i].toFloat();
+    nd.cosHalfAngle =
+        widened >= kPi ? -1.0f : std::nextafter(float(std::cos(widened)), -1.0f);
+  }
+}
+
 LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& options) {
   auto t0 = std::chrono::steady_clock::now();
   std::map<GroupKey, std::vector<uint32_t>> groups;
@@ -305,6 +359,7 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
       if (options.seedData) computeSeedData(lights, t);
     }
     if (t.preorder.size() != t.nodes.size()) computePreorder(t);
+    if (k.type == LightType::Directional) computeDirectionCones(lights, t);
     t.type = k.type;
     t.group = k.group;
     forest.trees[i] = std::move(t);

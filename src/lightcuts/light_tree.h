@@ -29,7 +29,8 @@ namespace lc::lightcuts {
 // 64 bytes: one cache line.
 struct LightNode {
   Vec3 lo, hi;          // bounds of light positions (directional trees: of directions to the light)
-  Vec3 axis;            // cone of light normals/axes (oriented, spot); unit
+  Vec3 axis;            // cone of light normals/axes (oriented, spot), of the lights' travel
+                        // directions (directional: computeDirectionCones); unit
   float cosHalfAngle;   // cone half-angle's cosine; -1 = all directions
   Color intensity;      // summed RGB intensity of the cluster
   uint32_t rep;         // representative light (index into LightSet::lights)
@@ -137,6 +138,11 @@ LightTree buildSeedTree(const LightSet& lights, const std::vector<uint32_t>& ind
 
 // Fills LightTree::preorder (buildLightForest calls it).
 void computePreorder(LightTree& tree);
+
+// Directional trees: sets each node's cone (axis, cosHalfAngle) to one holding its
+// lights' travel directions, a little wider than needed so that float rounding never makes
+// it too narrow (buildLightForest calls it; the builders leave these trees without cones).
+void computeDirectionCones(const LightSet& lights, LightTree& tree);
 
 // Fills LightTree::moments from the finished nodes (buildLightForest calls it).
 void computeMoments(const LightSet& lights, LightTree& tree);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 #include "io/ray_parser.h"
 #include "lightcuts/light_tree.h"
@@ -22,10 +23,9 @@ std::unique_ptr<scene::Scene> load(const std::string& text, int envLights = 0) {
   return s;
 }
 
-// Lightcuts at a relative error threshold of 0.5%: at the default 2% the cut's own error
-// on the furnace sphere reaches 2% (p99 2.0% with 1,024 lights, 1.4% with 4,096; what the
-// total criterion allows), which leaves no room for a 1% check.
-RenderResult renderLightcuts(const scene::Scene& s, int w, int threads = 0, float error = 0.005f) {
+// Lightcuts with the default options (--error 0.02) unless told.
+RenderResult renderLightcuts(const scene::Scene& s, int w, int threads = 0,
+                             float error = lightcuts::CutOptions{}.errorRatio) {
   lightcuts::LightForest forest = lightcuts::buildLightForest(s.lights());
   lightcuts::CutOptions co;
   co.errorRatio = error;
@@ -57,14 +57,18 @@ std::string furnace(int lights) {
 }
 
 // A diffuse sphere (kd 0.5, no specular) under a uniform environment of radiance 1 renders
-// as 0.5 within 1% at every pixel inside its silhouette, with Lightcuts (the default
-// method, at --error 0.005) and 1,024 or 4,096 directional lights; the background is 1.
+// as 0.5 within 1% at every pixel inside its silhouette, with Lightcuts at its defaults
+// (--error 0.02) and 1,024 or 4,096 directional lights; the background is 1. (Before the
+// first-order estimate of directional clusters and the exact sums of small clusters across
+// the horizon, p99 was 2.0% and 1.4% here; now the worst pixel is 0.01% and 0.45%.) At
+// --error 0.005 it holds within 0.5%.
 TEST(EnvironmentFurnace, DiffuseSphereRendersAsKdWithLightcuts) {
-  for (int n : {1024, 4096}) {
+  for (auto [n, error, tolerance] : {std::tuple{1024, 0.02f, 0.01f}, std::tuple{4096, 0.02f, 0.01f},
+                                     std::tuple{1024, 0.005f, 0.005f}, std::tuple{4096, 0.005f, 0.005f}}) {
     auto s = load(furnace(n));
     ASSERT_EQ(s->lights().countOf(LightType::Directional), size_t(n));
     const int W = 48;
-    RenderResult r = renderLightcuts(*s, W);
+    RenderResult r = renderLightcuts(*s, W, 0, error);
     int inside = 0;
     double worst = 0;
     for (int y = 0; y < W; ++y)
@@ -74,14 +78,14 @@ TEST(EnvironmentFurnace, DiffuseSphereRendersAsKdWithLightcuts) {
           ++inside;
           for (int ch = 0; ch < 3; ++ch) {
             worst = std::max(worst, std::fabs(double(c[ch]) / 0.5 - 1));
-            EXPECT_NEAR(c[ch], 0.5f, 0.005f) << "lights " << n << " pixel " << x << "," << y;
+            EXPECT_NEAR(c[ch], 0.5f, 0.5f * tolerance) << "lights " << n << " error " << error << " pixel " << x << "," << y;
           }
         } else if (x == 0 || y == 0) {
           EXPECT_FLOAT_EQ(c.y, 1.0f) << "the background is the environment's radiance";
         }
       }
     EXPECT_GT(inside, 800);
-    RecordProperty("worst_relative_error_" + std::to_string(n), std::to_string(worst));
+    RecordProperty("worst_relative_error_" + std::to_string(n) + "_" + std::to_string(error), std::to_string(worst));
   }
 }
 
