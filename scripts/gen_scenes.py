@@ -419,6 +419,7 @@ def cornell_water(out):
     out.write(hdr + body.rstrip() + "\n\n// The water surface and the tank's front face.\n")
     out.write(m.text("water_surface", water, per_line=3, digits=2))
     out.write(front.text("water_front", water, per_line=3, digits=2))
+    out.write('\n// With --caustics N: vpl caustic lights, which measured about half the cut of spot ones\n// here (docs/LIGHTCUTS.md, "Caustics").\ninstant_radiosity { caustic_lights = "vpl"; }\n')
 
 
 # --- church ------------------------------------------------------------------------------

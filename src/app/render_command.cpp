@@ -50,6 +50,7 @@ struct RenderArgs {
   std::string visibilityProbes = "on";
   std::string cutHeatmap;
   int referencePixels = 0;
+  std::string errorFloor = "auto";
   std::string reconstruct = "auto";
   std::string reconstructCoarse = "auto";
   std::string tonemap = "srgb";
@@ -225,6 +226,8 @@ int runRender(RenderArgs& a) {
   ro.maxDepth = a.maxDepth;
   ro.seed = a.seed;
   ro.referencePixels = a.referencePixels;
+  // --error-floor: auto (< 0 to the renderer), 0 (none) or an absolute luminance.
+  ro.errorFloor = a.errorFloor == "auto" ? -1.0f : std::stof(a.errorFloor);
   ro.reconstructSpacing = method == lightcuts::Method::Lightcuts ? reconstructSpacing(a.reconstruct, a.width, a.height) : 0;
   ro.reconstructCoarseSpacing = reconstructCoarseSpacing(a.reconstructCoarse, ro.reconstructSpacing);
   ro.cancel = &interruptFlag();
@@ -290,6 +293,8 @@ int runRender(RenderArgs& a) {
     j["method"] = lightcuts::methodName(method);
     j["error_threshold"] = error;
     j["max_cut"] = a.maxCut;
+    j["error_floor"] = rr.stats.errorFloor;
+    j["error_floor_pixels"] = rr.stats.errorFloorPixels;
     j["cut_criterion"] = a.criterion;
     j["estimator"] = a.estimator;
     j["visibility_probes"] = a.visibilityProbes;
@@ -510,6 +515,14 @@ void addRenderCommand(CLI::App& app) {
       ->group(cuts);
   c->add_option("--max-cut", a->maxCut, fmt::format("Most nodes in one cut; default {}", d.maxCut))
       ->check(CLI::Range(1, 1 << 30))
+      ->group(cuts);
+  c->add_option("--error-floor", a->errorFloor,
+                fmt::format("Lightcuts: luminance below which --error is an absolute error (a cut stops within error x "
+                            "max(estimate, floor)); auto = {} x the mean luminance of a {} x {} pre-pass (half the "
+                            "floor of compare's relative error), 0 = none (as published); default {}",
+                            render::kAutoErrorFloorFraction, render::kErrorFloorGrid, render::kErrorFloorGrid,
+                            d.errorFloor))
+      ->check(CLI::IsMember({"auto"}) | CLI::Range(0.0, 1e30))
       ->group(cuts);
   c->add_option("--cut-criterion", a->criterion,
                 fmt::format("When a lightcut stops: total (every bound below error x estimate and the root-sum-square "

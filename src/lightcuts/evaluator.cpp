@@ -303,7 +303,9 @@ class Lightcuts final : public LightEvaluator {
     const double rssFactor2 = kTotalFactor * kTotalFactor;
     while (!heap.empty()) {
       if (cutSize >= uint32_t(opt_.maxCut)) break;
-      float limit = float(eps * luminance(total));
+      // Weber's law has a floor: below errorFloor (set by the renderer from the image's
+      // mean) the cut is held to an absolute error, as the image metric's floor does.
+      float limit = float(eps * std::max(luminance(total), double(sp.errorFloor)));
       const uint64_t top = heap.front();
       if (keyBound(top) <= limit) {
         if (!rss) break;

@@ -113,6 +113,38 @@ TEST_P(CutMethods, ErrorStaysNearTheThresholdAndCutsAreSmall) {
   EXPECT_GE(stt.cutNodes, stw.cutNodes);
 }
 
+// The error floor (ShadingPoint::errorFloor): below it the criterion is an absolute error
+// of errorRatio x floor. A floor of 0 is the published criterion, bit for bit; a floor
+// far above the point's light stops the cut early and keeps its error within a few times
+// errorRatio x floor; one far below changes nothing.
+TEST_P(CutMethods, ErrorFloorBoundsAbsoluteError) {
+  LightSet s = cloud(20000, GetParam(), 4);
+  LightForest f = buildLightForest(s);
+  auto bf = makeBruteForce(s);
+  auto lc = makeLightcuts(s, f, CutOptions{0.02f, 4000});
+  HalfBlocked vis;
+  for (int i = 0; i < 20; ++i) {
+    ShadingPoint sp = point(Vec3(float(i) * 0.3f - 3, 0, 0.2f * float(i) - 2));
+    EvalStats st;
+    double exact = luminance(bf->evaluate(sp, vis, st).radiance);
+    EvalResult none = lc->evaluate(sp, vis, st);
+    if (!(exact > 0)) continue;  // all hidden: no floor to scale
+    sp.errorFloor = 0;
+    EvalResult zero = lc->evaluate(sp, vis, st);
+    EXPECT_EQ(none.radiance, zero.radiance);
+    EXPECT_EQ(none.cutSize, zero.cutSize);
+    sp.errorFloor = float(exact * 1e-3);
+    EvalResult low = lc->evaluate(sp, vis, st);
+    EXPECT_EQ(low.radiance, none.radiance);
+    const float floor = float(exact * 20);
+    sp.errorFloor = floor;
+    EvalResult high = lc->evaluate(sp, vis, st);
+    EXPECT_LT(high.cutSize, none.cutSize);
+    // The total criterion's error spreads sum to 1.6 x the limit; the estimate errs by less.
+    EXPECT_LT(std::fabs(luminance(high.radiance) - exact), 3 * 0.02 * floor) << i;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Kinds, CutMethods, ::testing::Values(LightType::Omni, LightType::Oriented),
                          [](const auto& info) { return std::string(lightTypeName(info.param)); });
 

@@ -19,6 +19,10 @@ struct ShadingPoint {
   Vec3 r;          // unit mirror direction of the view vector about n
   Color kd, ks;
   float shininess = 0;
+  // Luminance below which the relative error criterion counts absolute error (the cut
+  // stops when its bounds are within error x max(estimate, errorFloor)): the renderer's
+  // --error-floor, divided by the weight this point's light has in its pixel. 0 = none.
+  float errorFloor = 0;
 
   bool hasSpecular() const { return !isBlack(ks); }
   bool isBlackBody() const { return isBlack(kd) && isBlack(ks); }

@@ -231,6 +231,7 @@ struct Tracer {
   PrimaryHook* hook = nullptr;
   uint64_t secondaryRays = 0;
   uint64_t cutNodes = 0;  // summed over the shading points of the current sample
+  float errorFloor = 0;   // RenderOptions::errorFloor, resolved (a pixel's luminance)
 
   // The light at a shading point, timed in the thread's CPU time (lightingNanos: what the
   // shadow rays' time is a share of; CPU time, so that a preempted thread counts nothing).
@@ -265,7 +266,9 @@ struct Tracer {
     return evaluator.reconstruct(sp, vis, stats, hook->cell->merged[mask]);
   }
 
-  Color trace(const Ray& ray, int depth) {
+  // weight: the luminance of the product of kr and kt that carries this ray's light to
+  // the pixel (what the error floor is divided by).
+  Color trace(const Ray& ray, int depth, float weight = 1) {
     Hit h;
     // A ray that escapes sees the environment (camera, reflected and refracted rays alike).
     if (!scene.intersect(ray, h)) return scene.background(normalize(ray.d));
@@ -280,6 +283,7 @@ struct Tracer {
       sp.kd = m.kd;
       sp.ks = m.ks;
       sp.shininess = m.shininess;
+      sp.errorFloor = errorFloor > 0 && weight > 0 ? errorFloor / weight : 0;
       lightcuts::EvalResult r = directLight(h, sp, depth);
       L += r.radiance;
       cutNodes += r.cutSize;
@@ -290,7 +294,7 @@ struct Tracer {
       // A non-finite direction (NaN normal, extreme values) is dropped, not traced.
       if (isFinite(r)) {
         ++secondaryRays;
-        L += m.kr * trace(Ray{scene.offsetOrigin(h, r), r, 0, kInf}, depth + 1);
+        L += m.kr * trace(Ray{scene.offsetOrigin(h, r), r, 0, kInf}, depth + 1, weight * luminance(m.kr));
       }
     }
     if (!isBlack(m.kt)) {
@@ -308,7 +312,7 @@ struct Tracer {
       // A refracted ray with a non-finite direction is dropped, not traced.
       if (isFinite(t)) {
         ++secondaryRays;
-        L += m.kt * trace(Ray{scene.offsetOrigin(h, t), t, 0, kInf}, depth + 1);
+        L += m.kt * trace(Ray{scene.offsetOrigin(h, t), t, 0, kInf}, depth + 1, weight * luminance(m.kt));
       }
     }
     return L;
@@ -334,6 +338,7 @@ PixelResult renderPixel(const Scene& scene, const LightEvaluator& ev, const Rend
                         EvalStats& stats, uint64_t& primary, uint64_t& secondary, PrimaryHook* hook = nullptr) {
   Rng rng(o.seed, uint64_t(y) * uint64_t(o.width) + uint64_t(x));
   Tracer tr{scene, ev, o.maxDepth, stats, hook};
+  tr.errorFloor = std::max(0.0f, o.errorFloor);
   Color sum(0);
   const scene::Camera& cam = scene.camera();
   for (int s = 0; s < o.spp; ++s) {
@@ -670,8 +675,47 @@ Color traceRay(const Scene& scene, const LightEvaluator& evaluator, const Ray& r
   return tr.trace(ray, 0);
 }
 
-RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const RenderOptions& o) {
+namespace {
+
+// The automatic error floor: kAutoErrorFloorFraction of the mean luminance of up to
+// kErrorFloorGrid^2 pixel centres spread over the image, rendered without a floor.
+float autoErrorFloor(const Scene& scene, const LightEvaluator& evaluator, const RenderOptions& o, uint64_t& pixels) {
+  RenderOptions pre = o;
+  pre.spp = 1;
+  pre.errorFloor = 0;
+  const int gx = std::min(o.width, kErrorFloorGrid), gy = std::min(o.height, kErrorFloorGrid);
+  pixels = uint64_t(gx) * uint64_t(gy);
+  std::vector<double> lum(pixels, 0.0);
+  tbb::enumerable_thread_specific<EvalStats> stats;
+  tbb::parallel_for(0, gx * gy, [&](int i) {
+    if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
+    const int x = int((int64_t(i % gx) * 2 + 1) * o.width / (2 * gx)), y = int((int64_t(i / gx) * 2 + 1) * o.height / (2 * gy));
+    uint64_t a = 0, b = 0;
+    lum[size_t(i)] = std::max(0.0f, luminance(renderPixel(scene, evaluator, pre, x, y, stats.local(), a, b).color));
+  });
+  double sum = 0;
+  for (double l : lum) sum += l;  // in pixel order: the same floor whatever the threads
+  double mean = pixels > 0 ? sum / double(pixels) : 0;
+  return std::isfinite(mean) ? float(kAutoErrorFloorFraction * mean) : 0.0f;
+}
+
+}  // namespace
+
+RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const RenderOptions& given) {
   RenderResult res;
+  RenderOptions o = given;
+  std::unique_ptr<tbb::global_control> floorThreads;
+  if (o.threads > 0)
+    floorThreads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
+  const auto tFloor = Clock::now();
+  if (o.errorFloor < 0) {
+    o.errorFloor = evaluator.method() == lightcuts::Method::Lightcuts
+                       ? autoErrorFloor(scene, evaluator, o, res.stats.errorFloorPixels)
+                       : 0.0f;
+  }
+  if (!std::isfinite(o.errorFloor)) o.errorFloor = 0;
+  res.stats.errorFloor = o.errorFloor;
+  const double floorSeconds = secondsSince(tFloor);
   res.image = io::Image(o.width, o.height);
   res.cutSize.assign(size_t(o.width) * size_t(o.height), 0.0f);
   res.done.assign(size_t(o.width) * size_t(o.height), 0);
@@ -746,7 +790,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
         ++tilesDone;
       }
   });
-  res.stats.seconds = secondsSince(t0);
+  res.stats.seconds = secondsSince(t0) + floorSeconds;
   {
     std::lock_guard<std::mutex> lock(mu);
     finished = true;

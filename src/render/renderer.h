@@ -38,6 +38,13 @@ struct RenderOptions {
   // kCoarseMaxDisagreement in renderer.cpp); otherwise it splits down to
   // reconstructSpacing (and below, where pixels are not served).
   int reconstructCoarseSpacing = 0;
+  // Luminance floor of lightcuts' relative error criterion (ShadingPoint::errorFloor): a
+  // cut stops when its error bound is within error x max(estimate, floor), so pixels far
+  // darker than the image are held to an absolute error, as the image metric does (its
+  // relative error divides by at least 1% of the mean). 0 = none (the published
+  // criterion); < 0 = automatic: kAutoErrorFloorFraction of the mean luminance of a
+  // kErrorFloorGrid^2 pre-pass over the image without a floor.
+  float errorFloor = 0;
   // Set from a signal handler to stop early; the result is marked interrupted.
   std::atomic<bool>* cancel = nullptr;
   // Called from one thread with the fraction done (0..1), about ten times a second.
@@ -61,8 +68,15 @@ struct ReferenceStats {
   double bruteLightsPerShadingPoint = 0;
 };
 
+// --error-floor auto: half the image metric's floor (1% of the mean luminance), estimated
+// from a pre-pass of 32 x 32 pixel centres.
+constexpr float kAutoErrorFloorFraction = 0.005f;
+constexpr int kErrorFloorGrid = 32;
+
 struct RenderStats {
-  double seconds = 0;
+  double seconds = 0;  // with the error floor's pre-pass
+  float errorFloor = 0;  // the floor used (RenderOptions::errorFloor, resolved)
+  uint64_t errorFloorPixels = 0;  // pixels of the automatic floor's pre-pass
   uint64_t primaryRays = 0;
   uint64_t reconstructionSamples = 0;  // full lightcuts recorded as samples
   uint64_t reconstructionFallbacks = 0;  // primary hits whose samples did not match: full cuts
