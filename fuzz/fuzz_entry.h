@@ -17,7 +17,9 @@
 
 #include "core/error.h"
 #include "core/limits.h"
+#include "io/colormap.h"
 #include "io/image.h"
+#include "io/image_metrics.h"
 #include "io/obj_loader.h"
 #include "io/ray_parser.h"
 #include "lights/object_lights.h"
@@ -123,6 +125,25 @@ inline void loadScene(const uint8_t* data, size_t size, const std::string& baseD
     if (ir.seed) v.seed = *ir.seed;
     if (v.count > 0) (void)lights::addVpls(*s, v);
   }
+}
+
+// compare: the reference file's bytes, "%%TEST%%", the test file's (without the separator
+// both are the same bytes). Both read with readImage; when the sizes agree, the metrics,
+// their JSON and the relative-error heatmap as `lightcuts compare` computes them.
+inline constexpr std::string_view kTestSeparator = "%%TEST%%";
+inline void compareImages(const uint8_t* data, size_t size) {
+  std::string_view all(reinterpret_cast<const char*>(data), size);
+  size_t sep = all.find(kTestSeparator);
+  std::string_view ref = all.substr(0, sep);
+  std::string_view test = sep == std::string_view::npos ? ref : all.substr(sep + kTestSeparator.size());
+  std::string refPath = writeScratch("ref", ref), testPath = writeScratch("test", test);
+  const uint64_t maxPixels = tinyLimits().maxTexturePixels;
+  io::Image a = io::readImage(refPath, false, maxPixels);
+  io::Image b = io::readImage(testPath, false, maxPixels);
+  double threshold = size > 0 ? double(data[0]) / 64.0 : 0.02;  // compare --threshold, 0 .. ~4
+  io::ImageMetrics m = io::compareImages(a, b, threshold);
+  (void)io::metricsToJson(m);
+  (void)io::heatmap(io::relativeErrors(a, b), a.width, a.height, 0, 0.05f, "relative error");
 }
 
 }  // namespace lc::fuzz

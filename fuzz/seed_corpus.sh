@@ -7,7 +7,7 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 out="${1:?usage: seed_corpus.sh OUT_DIR}"
 max_bytes=262144  # larger files slow every iteration down; libFuzzer mutates small ones better
-mkdir -p "$out"/{ray_parser,obj_loader,image,scene}
+mkdir -p "$out"/{ray_parser,obj_loader,image,scene,compare,cli}
 
 # add TARGET FILE: copies FILE into the corpus under its content hash.
 add() {
@@ -50,11 +50,24 @@ for f in "$root"/fuzz/seeds/image/* "$root"/data/**/*.{png,jpg,jpeg,bmp,tga,hdr,
   add image "$f"
 done
 
+# compare: pairs of the image seeds, "REF%%TEST%%TEST" (the format of fuzz_entry.h's
+# compareImages): each image with itself, and with the next seed of the list.
+imgs=("$root"/fuzz/seeds/image/*)
+for i in "${!imgs[@]}"; do
+  for j in "$i" "$(( (i + 1) % ${#imgs[@]} ))"; do
+    { cat "${imgs[$i]}"; printf '%%%%TEST%%%%'; cat "${imgs[$j]}"; } > "$tmp"
+    add compare "$tmp"
+  done
+done
+
+# cli: the committed argument sets (one argument per line).
+for f in "$root"/fuzz/seeds/cli/*; do add cli "$f"; done
+
 # Regression inputs are seeds too (their targets must keep handling them).
-for t in ray_parser obj_loader image scene; do
+for t in ray_parser obj_loader image scene compare cli; do
   for f in "$root/data/regressions/$t"/*; do add "$t" "$f"; done
 done
 
-for t in ray_parser obj_loader image scene; do
+for t in ray_parser obj_loader image scene compare cli; do
   echo "seed_corpus: $t: $(ls "$out/$t" | wc -l) files"
 done

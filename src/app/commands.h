@@ -12,6 +12,8 @@ void addInfoCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addObj2RayCommand(CLI::App& app);
 void addSkyCommand(CLI::App& app);
+// Every command above, and the top level's rules (main.cpp and the CLI fuzz target).
+void addCommands(CLI::App& app);
 
 // Exit status of the subcommand that ran (set by its callback).
 int& exitStatus();

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "../../fuzz/cli_entry.h"
 #include "../../fuzz/fuzz_entry.h"
 #include "test_util.h"
 
@@ -62,6 +63,23 @@ TEST(FuzzRegression, Image) {
 
 TEST(FuzzRegression, Scene) {
   replay("scene", [](const uint8_t* d, size_t n) { lc::fuzz::loadScene(d, n, kSceneDir); });
+}
+
+TEST(FuzzRegression, Compare) {
+  replay("compare", [](const uint8_t* d, size_t n) { lc::fuzz::compareImages(d, n); });
+}
+
+TEST(FuzzRegression, Cli) {
+  replay("cli", [](const uint8_t* d, size_t n) { lc::fuzz::parseArgs(d, n); });
+}
+
+// The CLI target's seeds parse (or are refused) cleanly: the entry point works at all.
+TEST(FuzzRegression, CliSeedsParse) {
+  for (const auto& e : fs::directory_iterator(lc::testing::sourceDir() + "/fuzz/seeds/cli")) {
+    SCOPED_TRACE(e.path().string());
+    std::string bytes = slurp(e.path().string());
+    EXPECT_NO_THROW(lc::fuzz::parseArgs(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()));
+  }
 }
 
 // The committed seeds load too (a sanity check that the entry points work at all).

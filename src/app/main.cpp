@@ -11,15 +11,6 @@
 #include "core/error.h"
 
 namespace lc::app {
-int& exitStatus() {
-  static int status = 0;
-  return status;
-}
-std::string& commandLine() {
-  static std::string line;
-  return line;
-}
-
 namespace {
 std::string shellQuote(const std::string& arg) {
   bool plain = !arg.empty();
@@ -35,19 +26,10 @@ std::string shellQuote(const std::string& arg) {
 int main(int argc, char** argv) {
   CLI::App app{"lightcuts: a ray tracer for the SBT .ray format that renders thousands to millions of lights "
                "with Lightcuts (Walter et al. 2005), the course project's cuts, or brute force"};
-  // At most one subcommand; none prints the help (below).
-  app.require_subcommand(0, 1);
-  app.set_version_flag("--version", "lightcuts " LC_VERSION);
-  // --help-all: every subcommand's options too (the man page is made from it).
-  app.set_help_all_flag("--help-all", "Print this help with every subcommand's options, and exit");
+  lc::app::addCommands(app);
   std::string& line = lc::app::commandLine();
   line = "lightcuts";
   for (int i = 1; i < argc; ++i) line += " " + lc::app::shellQuote(argv[i]);
-  lc::app::addRenderCommand(app);
-  lc::app::addInfoCommand(app);
-  lc::app::addCompareCommand(app);
-  lc::app::addObj2RayCommand(app);
-  lc::app::addSkyCommand(app);
   try {
     app.parse(argc, argv);
     // No subcommand: the help, as for --help (stdout, status 0), rather than CLI11's
