@@ -9,7 +9,6 @@
 #include "io/colormap.h"
 #include "io/image.h"
 #include "io/image_metrics.h"
-#include "io/obj_loader.h"
 
 namespace lc::app {
 
@@ -71,39 +70,15 @@ void addCompareCommand(CLI::App& app) {
   c->add_option("test", a->test, "Test image, same size")->required();
   c->add_flag("--json", a->json, "Print the metrics as JSON");
   c->add_option("--heatmap", a->heatmap, "Write the per-pixel relative error, colour-mapped with a legend, to this PNG");
-  c->add_option("--heatmap-max", a->heatmapMax, "Relative error at the top of the heatmap's scale (default 0.05)")
+  const CompareArgs d;
+  c->add_option("--heatmap-max", a->heatmapMax,
+                fmt::format("Relative error at the top of the heatmap's scale; default {:g}", d.heatmapMax))
       ->check(CLI::Range(1e-6f, 1e6f));
-  c->add_option("--threshold", a->threshold, "Relative error counted by fraction_over_threshold (also written as fraction_over_2pct; default 0.02)")
+  c->add_option("--threshold", a->threshold,
+                fmt::format("Relative error counted by fraction_over_threshold (also written as fraction_over_2pct); "
+                            "default {:g}", d.threshold))
       ->check(CLI::Range(0.0, 1e6));
   c->callback([a] { exitStatus() = runCompare(*a); });
-}
-
-// obj2ray's output when -o is not given: the input with its extension replaced by .ray, in
-// the input's folder ("models/cube.obj" -> "models/cube.ray", "cube" -> "cube.ray").
-std::string defaultRayOutput(const std::string& input) {
-  return std::filesystem::path(input).replace_extension(".ray").string();
-}
-
-void addObj2RayCommand(CLI::App& app) {
-  auto in = std::make_shared<std::string>();
-  auto out = std::make_shared<std::string>();
-  CLI::App* c = app.add_subcommand("obj2ray", "Convert an OBJ/MTL model to an equivalent .ray scene");
-  c->add_option("input", *in, "OBJ file")->required();
-  c->add_option("-o,--output", *out,
-                "Output .ray file (default: the input with its extension replaced by .ray, in the input's folder: "
-                "model.obj -> model.ray)");
-  c->callback([in, out] {
-    if (out->empty()) {
-      *out = defaultRayOutput(*in);
-      // A default that would overwrite the input (IN is already .ray) is refused, not written.
-      checkDistinctPaths({{*in, "the input OBJ"}, {*out, "the default output (the input with .ray; choose another with -o)"}});
-    } else {
-      checkDistinctPaths({{*in, "the input OBJ"}, {*out, "-o"}});
-    }
-    io::writeRayFromObj(*in, *out, Limits{});
-    fmt::print("wrote {}\n", *out);
-    exitStatus() = 0;
-  });
 }
 
 }  // namespace lc::app
