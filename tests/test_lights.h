@@ -8,7 +8,7 @@
 #include "lightcuts/cluster.h"
 #include "lightcuts/light_tree.h"
 #include "lightcuts/shading.h"
-#include "scene/light.h"
+#include "core/light.h"
 
 namespace lc::lightcuts::test_lights {
 

@@ -8,7 +8,7 @@
 
 #include "lights/environment_lights.h"
 #include "lights/object_lights.h"
-#include "scene/light.h"
+#include "core/light.h"
 
 namespace lc::app {
 

@@ -25,7 +25,7 @@
 #include "lightcuts/light_tree.h"
 #include "lightcuts/reconstruction.h"
 #include "lightcuts/shading.h"
-#include "scene/light.h"
+#include "core/light.h"
 
 namespace lc::lightcuts {
 

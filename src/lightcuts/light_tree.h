@@ -22,7 +22,7 @@
 
 #include "core/math.h"
 #include "core/progress.h"
-#include "scene/light.h"
+#include "core/light.h"
 
 namespace lc::lightcuts {
 

@@ -9,7 +9,7 @@
 
 #include "core/math.h"
 #include "lightcuts/shading.h"
-#include "scene/light.h"
+#include "core/light.h"
 
 namespace lc::lightcuts {
 

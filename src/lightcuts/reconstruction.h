@@ -28,7 +28,7 @@
 #include "lightcuts/light_tree.h"
 #include "lightcuts/merged_batch.h"
 #include "lightcuts/shading.h"
-#include "scene/light.h"
+#include "core/light.h"
 
 namespace lc::lightcuts {
 

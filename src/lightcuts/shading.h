@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "core/math.h"
-#include "scene/light.h"
+#include "core/light.h"
 
 namespace lc::lightcuts {
 

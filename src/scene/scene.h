@@ -14,7 +14,7 @@
 #include "io/scene_desc.h"
 #include "scene/camera.h"
 #include "scene/environment.h"
-#include "scene/light.h"
+#include "core/light.h"
 #include "scene/material.h"
 #include "scene/shape.h"
 
