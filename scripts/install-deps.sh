@@ -16,6 +16,8 @@ pkgs=(
   nlohmann-json3-dev   # nlohmann/json: --stats and --json output
   libgtest-dev         # GoogleTest: the test suite
   libbenchmark-dev     # Google Benchmark: micro benchmarks under bench/
+  libopenmpi-dev       # Open MPI: distributed rendering over MPI (mpirun -np K lightcuts render ...; CMake LC_MPI)
+  openmpi-bin          # Open MPI's mpirun: launching those jobs, and the MPI tests (src/app/distributed_test.cpp)
 )
 if [ $# -gt 0 ]; then pkgs=("$@"); fi
 missing=()

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "lights/object_lights.h"
+#include "render/renderer.h"
 #include "scene/light.h"
 
 namespace lc::app {
@@ -17,5 +18,11 @@ nlohmann::json lightCountsJson(const LightSet& lights);
 std::string lightCountsLine(const LightSet& lights);
 // One object per luminous object: shape, name, lights, area, power.
 nlohmann::json objectLightsJson(const std::vector<lights::ObjectLightInfo>& infos);
+
+// A render's counters (rays, cuts, reconstruction) as JSON and back, to add the ranks'
+// statistics of a distributed render on rank 0: addRenderCounters(s, renderCountersJson(t))
+// adds t's counters to s (times are left alone).
+nlohmann::json renderCountersJson(const render::RenderStats& stats);
+void addRenderCounters(render::RenderStats& stats, const nlohmann::json& counters);
 
 }  // namespace lc::app
