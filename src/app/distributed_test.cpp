@@ -263,6 +263,23 @@ TEST(Distributed, SameImageAsOneProcessWithSupersampling) {
                                                  "--reference-pixels", "30"}});
 }
 
+// Every rank meets the same bad input: the job fails with rank 0's message, once.
+TEST(Distributed, AnErrorIsReportedOnceAndFailsTheJob) {
+  SKIP_WITHOUT_MPI();
+  TempDir dir;
+  std::ofstream(dir.file("bad.ray")) << "SBT-raytracer 1.0\ncamera { position = (0,0,10)\n";
+  Job job(2, {"render", "bad.ray", "-o", "out.png"}, dir.path());
+  ASSERT_TRUE(job.wait(60));
+  EXPECT_EQ(job.status(), 1) << job.err();
+  const std::string msg = "lightcuts: bad.ray:3:1: error: expected '}' to close camera opened at 2:8, got end of file";
+  std::string err = job.err();
+  size_t first = err.find(msg);
+  ASSERT_NE(first, std::string::npos) << err;
+  EXPECT_EQ(err.find(msg, first + 1), std::string::npos) << "reported more than once:\n" << err;
+  EXPECT_EQ(err.find("rank 1"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir.file("out.png")));
+}
+
 // A scene that takes minutes to render by brute force: 600 point lights over a plane.
 std::string slowScene() {
   std::string s = "SBT-raytracer 1.0\ncamera { position = (0,0,10); viewdir = (0,0,-1); }\n";
