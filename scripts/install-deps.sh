@@ -17,6 +17,8 @@ pkgs=(
   libgtest-dev         # GoogleTest: the test suite
   libbenchmark-dev     # Google Benchmark: micro benchmarks under bench/
   help2man             # the man page (lightcuts.1) from `lightcuts --help-all`; skipped without it
+  libopenmpi-dev       # Open MPI: distributed rendering over MPI (mpirun -np K lightcuts render ...; CMake LC_MPI)
+  openmpi-bin          # Open MPI's mpirun: launching those jobs, and the MPI tests (src/app/distributed_test.cpp)
 )
 if [ $# -gt 0 ]; then pkgs=("$@"); fi
 missing=()

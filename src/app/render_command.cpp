@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.h"
+#include "app/distributed.h"
 #include "app/interrupt.h"
 #include "app/progress.h"
 #include "app/scene_loader.h"
@@ -111,8 +112,63 @@ std::string defaultOutput(const std::string& scene) {
   return stem + ".png";
 }
 
+// Every rank's part of a distributed render, as JSON: rank 0 puts it under "mpi" in --stats
+// and adds the counters ("counters", removed there) to the job's totals.
+nlohmann::json rankJson(const Cluster& cluster, int threads, const LoadedScene& ls, double treeSeconds,
+                        const render::RenderResult& rr) {
+  const auto& st = rr.stats;
+  uint64_t rays = st.primaryRays + st.secondaryRays + st.eval.shadowRays;
+  return {{"rank", cluster.rank()},
+          {"host", cluster.host()},
+          {"threads", threads},
+          {"tiles", st.tiles},
+          {"pixels", st.pixels},
+          {"time_load_s", ls.loadSeconds},
+          {"time_accel_s", ls.accelSeconds},
+          {"time_lights_s", ls.lightSeconds},
+          {"time_tree_s", treeSeconds},
+          {"time_tiles_s", st.tileSeconds},
+          {"time_render_s", st.seconds},
+          {"time_reference_s", st.reference.bruteSeconds},
+          {"reference_pixels", st.reference.localPixels},
+          {"primary_rays", st.primaryRays},
+          {"secondary_rays", st.secondaryRays},
+          {"shadow_rays", st.eval.shadowRays},
+          {"shading_points", st.eval.shadingPoints},
+          {"rays_per_second", st.tileSeconds > 0 ? double(rays) / st.tileSeconds : 0},
+          {"counters", renderCountersJson(st)}};
+}
+
+int renderJob(RenderArgs& a, Cluster* cluster);
+
 int runRender(RenderArgs& a) {
+  // Under an MPI launcher (mpirun, srun) every process runs this; see app/distributed.h.
+  std::unique_ptr<Cluster> cluster = joinCluster();
+  int status = 0;
+  if (!cluster || cluster->rank() == 0) {
+    status = renderJob(a, cluster.get());
+  } else {
+    try {
+      status = renderJob(a, cluster.get());
+    } catch (const Error& e) {
+      // Every rank reads the same input, so rank 0 most likely fails the same way: give it
+      // a moment to say so and end the job (which ends this rank too), rather than print
+      // the message once per rank.
+      std::this_thread::sleep_for(std::chrono::seconds(2));
+      throw Error(fmt::format("rank {} on {}: {}", cluster->rank(), cluster->host(), e.what()));
+    }
+  }
+  // A clean end only when every rank is done; otherwise this process's exit (non-zero)
+  // ends the job.
+  if (status == 0 && cluster) cluster->finish();
+  return status;
+}
+
+int renderJob(RenderArgs& a, Cluster* cluster) {
   auto t0 = std::chrono::steady_clock::now();
+  const bool distributed = cluster && cluster->size() > 1;
+  const bool root = !cluster || cluster->rank() == 0;  // writes the image and reports
+  if (!root) a.quiet = true;
   if (a.out.empty()) a.out = defaultOutput(a.scene);
   checkDistinctPaths({{a.scene, "the scene"}, {a.out, "-o"}, {a.stats, "--stats"}, {a.cutHeatmap, "--cut-heatmap"}});
   std::string ext = fileExtension(a.out);
@@ -121,10 +177,12 @@ int runRender(RenderArgs& a) {
     throw Error("cannot write '" + a.out + "': no file extension to choose the format (use .png, .ppm, .bmp or .exr)");
   if (!io::isWritableImageExtension(ext))
     throw Error("cannot write '" + a.out + "': unknown image format '." + ext + "' (use .png, .ppm, .bmp or .exr)");
-  // Fail before a long render, not after it.
-  checkWritable(a.out);
-  if (!a.stats.empty()) checkWritable(a.stats);
-  if (!a.cutHeatmap.empty()) checkWritable(a.cutHeatmap);
+  // Fail before a long render, not after it (only rank 0 writes).
+  if (root) {
+    checkWritable(a.out);
+    if (!a.stats.empty()) checkWritable(a.stats);
+    if (!a.cutHeatmap.empty()) checkWritable(a.cutHeatmap);
+  }
   lightcuts::Method method = lightcuts::parseMethod(a.method);
   lightcuts::TreeBuildOptions tb;
   tb.builder = a.tree.empty() ? (method == lightcuts::Method::Seed ? lightcuts::TreeBuilder::Seed
@@ -150,12 +208,13 @@ int runRender(RenderArgs& a) {
     ls = loadScene(a.scene, a.load);
   } catch (const Interrupted&) {
     // Stopped while making the lights: nothing rendered, nothing written.
-    fmt::print(stderr, "lightcuts: interrupted; {} untouched\n", a.out);
+    if (root) fmt::print(stderr, "lightcuts: interrupted; {} untouched\n", a.out);
     return interruptExitStatus();
   }
   scene::Scene& scene = *ls.scene;
   // The loader's warnings carry their location: "file:line:col: warning: ...".
-  for (const std::string& w : ls.warnings) fmt::print(stderr, "lightcuts: {}\n", w);
+  if (root)
+    for (const std::string& w : ls.warnings) fmt::print(stderr, "lightcuts: {}\n", w);
   if (!ls.objDescription.empty() && !a.quiet)
     fmt::print(stderr, "OBJ input: added a default camera and lights:\n{}\n", ls.objDescription);
 
@@ -190,11 +249,11 @@ int runRender(RenderArgs& a) {
   }
   scene.setCamera(scene::Camera::fromDesc(camera, float(a.width) / float(a.height)));
   // (after the checks above: an error is not preceded by warnings about a render that will not run)
-  if (scene.lights().size() == 0)
+  if (root && scene.lights().size() == 0)
     printWarning("the scene has no lights: only emissive and ambient colours will show (add a point_light, "
                  "directional_light, spot_light or area_light, or a luminosity to a material)");
   const bool objInput = fileExtension(a.scene) == "obj";
-  if (objInput && !ls.objectLights.empty() && ls.vpls.vpls == 0 && a.load.gi && !a.load.vplCount)
+  if (root && objInput && !ls.objectLights.empty() && ls.vpls.vpls == 0 && a.load.gi && !a.load.vplCount)
     printHint("the OBJ's emissive materials light what they see directly, nothing bounces; --vpls 10000 adds "
               "indirect light (global illumination)");
 
@@ -231,6 +290,11 @@ int runRender(RenderArgs& a) {
   ro.reconstructSpacing = method == lightcuts::Method::Lightcuts ? reconstructSpacing(a.reconstruct, a.width, a.height) : 0;
   ro.reconstructCoarseSpacing = reconstructCoarseSpacing(a.reconstructCoarse, ro.reconstructSpacing);
   ro.cancel = &interruptFlag();
+  std::unique_ptr<render::WorkShare> share;
+  if (distributed) {
+    share = cluster->workShare(&interruptFlag());
+    ro.share = share.get();
+  }
   ProgressBar bar("rendering", a.quiet);
   ro.progress = [&](double f) { bar.update(f); };
   ProgressBar refBar("reference pixels", a.quiet);
@@ -242,14 +306,48 @@ int runRender(RenderArgs& a) {
   interrupts.reset();
 
   if (rr.interrupted || interruptFlag().load()) {
+    if (!root) {
+      // Rank 0 keeps what it gathered. The launcher passes a Ctrl-C on to every rank as
+      // SIGTERM, and when one rank exits it kills the others at once (Open MPI's mpirun):
+      // so wait here, and let rank 0 write the partial image in the second mpirun gives
+      // before SIGKILL.
+      std::this_thread::sleep_for(std::chrono::seconds(3));
+      return interruptExitStatus();
+    }
     // Leave the requested output alone; keep what was rendered in OUT.partial.exr.
     std::string partial = a.out + ".partial.exr";
     io::WriteOptions po;
     po.metadata = metadata(a);
     io::writeImage(partial, rr.image, po);
     fmt::print(stderr, "lightcuts: interrupted; {} untouched, partial image in {}\n", a.out, partial);
+    if (distributed && interruptSignal() == SIGTERM)
+      fmt::print(stderr, "lightcuts: (under MPI, SIGTERM comes from the launcher: the job was interrupted, or "
+                         "another rank failed)\n");
     return interruptExitStatus();
   }
+
+  // A distributed render: every rank's statistics to rank 0, added to the job's totals.
+  nlohmann::json perRank = nlohmann::json::array();
+  double loadBalance = 1;
+  if (distributed) {
+    int threads = a.threads > 0 ? a.threads : int(std::thread::hardware_concurrency());
+    std::vector<std::string> all =
+        cluster->gather(rankJson(*cluster, threads, ls, forest.buildSeconds, rr).dump(), &interruptFlag());
+    if (!root) return 0;
+    if (all.size() != size_t(cluster->size())) throw Error("interrupted while gathering the ranks' statistics");
+    double sumTiles = 0, maxTiles = 0;
+    for (size_t r = 0; r < all.size(); ++r) {
+      nlohmann::json j = nlohmann::json::parse(all[r]);
+      if (r > 0) addRenderCounters(rr.stats, j.at("counters"));
+      j.erase("counters");
+      sumTiles += j.at("time_tiles_s").get<double>();
+      maxTiles = std::max(maxTiles, j.at("time_tiles_s").get<double>());
+      perRank.push_back(std::move(j));
+    }
+    // Mean over max of the time each rank spent until its last tile: 1 when all finish together.
+    loadBalance = maxTiles > 0 ? sumTiles / double(all.size()) / maxTiles : 1;
+  }
+
 
   io::WriteOptions wo;
   wo.tonemap = tonemap;
@@ -372,6 +470,8 @@ int runRender(RenderArgs& a) {
                         {"threshold", render::ReferenceStats::kThreshold},
                         {"brute_lights_per_shading_point", ref.bruteLightsPerShadingPoint}};
     }
+    if (distributed)
+      j["mpi"] = {{"ranks", cluster->size()}, {"load_balance", loadBalance}, {"per_rank", perRank}};
     std::string text = j.dump(2) + "\n";
     writeFileAtomically(a.stats, [&](const std::string& tmp) {
       FILE* f = std::fopen(tmp.c_str(), "wb");
@@ -401,6 +501,16 @@ int runRender(RenderArgs& a) {
                  double(forest.memoryBytes()) / (1 << 20), formatSeconds(forest.buildSeconds), error,
                  method == lightcuts::Method::Lightcuts ? " (" + a.criterion + " criterion)" : "", a.maxCut);
     fmt::print("image      {}x{}, {} spp -> {}\n", a.width, a.height, a.spp, a.out);
+    if (distributed) {
+      std::string tiles, busy;
+      for (const auto& r : perRank) {
+        tiles += fmt::format("{}{}", tiles.empty() ? "" : " / ", r.at("tiles").get<uint64_t>());
+        busy += fmt::format("{}{:.2f}", busy.empty() ? "" : " / ", r.at("time_tiles_s").get<double>());
+      }
+      int threads = perRank[0].at("threads").get<int>();
+      fmt::print("mpi        {} ranks x {} thread{}: tiles {}, busy {} s; load balance {:.0f}%\n", cluster->size(),
+                 threads, threads == 1 ? "" : "s", tiles, busy, 100 * loadBalance);
+    }
     if (ro.reconstructSpacing > 1)
       fmt::print("recon.     full lightcuts every {} pixels ({} samples{}); {} points rebuilt from them, {} got full cuts\n",
                  ro.reconstructSpacing, formatCount(double(rr.stats.reconstructionSamples)),

@@ -34,4 +34,50 @@ nlohmann::json environmentLightsJson(const std::vector<lights::EnvironmentLightI
   return envs;
 }
 
+namespace {
+// Every counter of EvalStats, in one order for both directions.
+template <class S, class F>
+void forEachEvalCounter(S& s, F&& f) {
+  f("shading_points", s.shadingPoints);
+  f("cut_nodes", s.cutNodes);
+  f("shadow_rays", s.shadowRays);
+  f("bounds_evaluated", s.boundsEvaluated);
+  f("reconstructed_points", s.reconstructedPoints);
+  f("probed_clusters", s.probedClusters);
+  f("probe_rays", s.probeRays);
+  f("occluded_rays", s.occludedRays);
+  f("hidden_clusters", s.hiddenClusters);
+  f("group_probes", s.groupProbes);
+  f("failed_group_probes", s.failedGroupProbes);
+  f("traced_rays", s.tracedRays);
+  f("timed_rays", s.timedRays);
+  f("timed_ray_nanos", s.timedRayNanos);
+  f("lighting_nanos", s.lightingNanos);
+}
+}  // namespace
+
+nlohmann::json renderCountersJson(const render::RenderStats& st) {
+  nlohmann::json j;
+  forEachEvalCounter(st.eval, [&](const char* k, uint64_t v) { j[k] = v; });
+  j["cut_histogram"] = st.eval.cutHistogram;
+  j["primary_rays"] = st.primaryRays;
+  j["secondary_rays"] = st.secondaryRays;
+  j["reconstruction_samples"] = st.reconstructionSamples;
+  j["reconstruction_fallbacks"] = st.reconstructionFallbacks;
+  j["reconstruction_coarse_cells"] = st.reconstructionCoarseCells;
+  return j;
+}
+
+void addRenderCounters(render::RenderStats& st, const nlohmann::json& j) {
+  lightcuts::EvalStats e;
+  forEachEvalCounter(e, [&](const char* k, uint64_t& v) { v = j.at(k).get<uint64_t>(); });
+  e.cutHistogram = j.at("cut_histogram").get<decltype(e.cutHistogram)>();
+  st.eval.add(e);
+  st.primaryRays += j.at("primary_rays").get<uint64_t>();
+  st.secondaryRays += j.at("secondary_rays").get<uint64_t>();
+  st.reconstructionSamples += j.at("reconstruction_samples").get<uint64_t>();
+  st.reconstructionFallbacks += j.at("reconstruction_fallbacks").get<uint64_t>();
+  st.reconstructionCoarseCells += j.at("reconstruction_coarse_cells").get<uint64_t>();
+}
+
 }  // namespace lc::app

@@ -9,6 +9,7 @@
 #include "lights/environment_lights.h"
 #include "lights/object_lights.h"
 #include "core/light.h"
+#include "render/renderer.h"
 
 namespace lc::app {
 
@@ -22,5 +23,10 @@ nlohmann::json objectLightsJson(const std::vector<lights::ObjectLightInfo>& info
 // One object per environment_light / sun_sky_light: what it is, its directional lights
 // and their power (sum of intensities x pi).
 nlohmann::json environmentLightsJson(const std::vector<lights::EnvironmentLightInfo>& infos);
+// A render's counters (rays, cuts, reconstruction) as JSON and back, to add the ranks'
+// statistics of a distributed render on rank 0: addRenderCounters(s, renderCountersJson(t))
+// adds t's counters to s (times are left alone).
+nlohmann::json renderCountersJson(const render::RenderStats& stats);
+void addRenderCounters(render::RenderStats& stats, const nlohmann::json& counters);
 
 }  // namespace lc::app

@@ -701,6 +701,24 @@ float autoErrorFloor(const Scene& scene, const LightEvaluator& evaluator, const 
 
 }  // namespace
 
+TileRect TileGrid::rect(int t) const {
+  int tx = t % tilesX, ty = t / tilesX;
+  return {tx * tile, ty * tile, std::min(width, (tx + 1) * tile), std::min(height, (ty + 1) * tile)};
+}
+
+TileGrid tileGrid(const RenderOptions& o, const LightEvaluator& evaluator) {
+  const int S = o.reconstructSpacing;
+  const bool recon = S > 1 && evaluator.supportsReconstruction();
+  const int C = std::max(S, o.reconstructCoarseSpacing);
+  TileGrid g;
+  g.width = o.width;
+  g.height = o.height;
+  g.tile = recon ? (64 + C - 1) / C * C : 16;
+  g.tilesX = (o.width + g.tile - 1) / g.tile;
+  g.tilesY = (o.height + g.tile - 1) / g.tile;
+  return g;
+}
+
 RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const RenderOptions& given) {
   RenderResult res;
   RenderOptions o = given;
@@ -731,6 +749,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     std::vector<uint8_t> slotState;
     std::vector<const CutSample*> slotSample;
     uint64_t coarseCells = 0;
+    uint64_t tiles = 0, pixels = 0;
     CellCuts cell;                  // merged cuts of the current cell
   };
   tbb::enumerable_thread_specific<Local> locals;
@@ -741,55 +760,84 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   const int S = o.reconstructSpacing;
   const bool recon = S > 1 && evaluator.supportsReconstruction();
   const int C = std::max(S, o.reconstructCoarseSpacing);
-  const int kTile = recon ? (64 + C - 1) / C * C : 16;
+  const TileGrid grid = tileGrid(o, evaluator);
+  const int kTile = grid.tile;
   RenderOptions centre = o;  // samples are traced through pixel centres
   centre.spp = 1;
   centre.progress = nullptr;
-  int tilesX = (o.width + kTile - 1) / kTile, tilesY = (o.height + kTile - 1) / kTile;
   EdgeSamples edges(recon ? o.width : 0, recon ? o.height : 0, kTile);
   std::atomic<int> tilesDone{0};
   std::atomic<bool> finished{false};
-  int totalTiles = tilesX * tilesY;
+  int totalTiles = grid.count();
+  WorkShare* share = o.share;
+  if (share) share->begin(grid, res);
 
   // Progress is reported from its own thread so rendering threads never wait on output.
   std::mutex mu;
   std::condition_variable cv;
   std::thread reporter;
+  auto fraction = [&] { return share ? share->fractionDone() : double(tilesDone) / double(totalTiles); };
   if (o.progress) {
     reporter = std::thread([&] {
       std::unique_lock<std::mutex> lock(mu);
       while (!finished) {
-        o.progress(double(tilesDone) / double(totalTiles));
+        o.progress(fraction());
         cv.wait_for(lock, std::chrono::milliseconds(100));
       }
     });
   }
 
   auto t0 = Clock::now();
-  tbb::parallel_for(tbb::blocked_range2d<int>(0, tilesY, 1, 0, tilesX, 1), [&](const tbb::blocked_range2d<int>& r) {
-    Local& L = locals.local();
-    for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
-      for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx) {
-        if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
-        int x0 = tx * kTile, y0 = ty * kTile;
-        int x1 = std::min(o.width, (tx + 1) * kTile), y1 = std::min(o.height, (ty + 1) * kTile);
-        if (!recon) {
-          // Cancellation is checked at every pixel: one tile of many samples can take seconds.
-          for (int y = y0; y < y1; ++y)
-            for (int x = x0; x < x1; ++x) {
-              if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
-              storePixel(res, o.width, x, y, renderPixel(scene, evaluator, o, x, y, L.stats, L.primary, L.secondary));
-            }
-          ++tilesDone;
-          continue;
+  std::atomic<int64_t> lastTileNs{0};  // when the last tile rendered here was done
+  // One tile; false when cancelled inside it.
+  auto renderTile = [&](Local& L, int t) {
+    const TileRect tr = grid.rect(t);
+    const int x0 = tr.x0, y0 = tr.y0, x1 = tr.x1, y1 = tr.y1;
+    if (!recon) {
+      // Cancellation is checked at every pixel: one tile of many samples can take seconds.
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return false;
+          storePixel(res, o.width, x, y, renderPixel(scene, evaluator, o, x, y, L.stats, L.primary, L.secondary));
         }
-        ReconstructionTile rt{scene, evaluator, o, centre, L.stats, L.primary, L.secondary, L.samples, L.fallbacks,
-                              L.coarseCells, L.slots, L.slotState, L.slotSample, L.cell, res, edges, x0, y0, x1, y1};
-        rt.run(S, C);
-        edges.tileDone(x0, y0, x1, y1);
-        ++tilesDone;
+    } else {
+      ReconstructionTile rt{scene, evaluator, o, centre, L.stats, L.primary, L.secondary, L.samples, L.fallbacks,
+                            L.coarseCells, L.slots, L.slotState, L.slotSample, L.cell, res, edges, x0, y0, x1, y1};
+      rt.run(S, C);
+      edges.tileDone(x0, y0, x1, y1);
+      if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return false;
+    }
+    ++L.tiles;
+    L.pixels += uint64_t(x1 - x0) * uint64_t(y1 - y0);
+    ++tilesDone;
+    int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
+    for (int64_t prev = lastTileNs.load(); prev < ns && !lastTileNs.compare_exchange_weak(prev, ns);) {
+    }
+    return true;
+  };
+  if (!share) {
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, grid.tilesY, 1, 0, grid.tilesX, 1),
+                      [&](const tbb::blocked_range2d<int>& r) {
+                        Local& L = locals.local();
+                        for (int ty = r.rows().begin(); ty < r.rows().end(); ++ty)
+                          for (int tx = r.cols().begin(); tx < r.cols().end(); ++tx) {
+                            if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
+                            if (!renderTile(L, ty * grid.tilesX + tx)) return;
+                          }
+                      });
+  } else {
+    // Each worker asks the share for tiles until none is left.
+    const int workers = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    tbb::parallel_for(0, std::max(1, workers), 1, [&](int) {
+      Local& L = locals.local();
+      for (int t; (t = share->next()) >= 0;) {
+        if (!renderTile(L, t)) return;
+        share->rendered(t, res);
       }
-  });
+    });
+    share->endTiles();
+  }
+  res.stats.tileSeconds = double(lastTileNs.load()) * 1e-9;
   res.stats.seconds = secondsSince(t0) + floorSeconds;
   {
     std::lock_guard<std::mutex> lock(mu);
@@ -797,7 +845,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   }
   cv.notify_all();
   if (reporter.joinable()) reporter.join();
-  if (o.progress) o.progress(double(tilesDone) / double(totalTiles));
+  if (o.progress) o.progress(fraction());
   // A cancelled render may stop inside a tile (tiles check at every pixel).
   res.interrupted = o.cancel && o.cancel->load() && std::find(res.done.begin(), res.done.end(), 0) != res.done.end();
 
@@ -808,6 +856,8 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     res.stats.reconstructionSamples += L.samples;
     res.stats.reconstructionFallbacks += L.fallbacks;
     res.stats.reconstructionCoarseCells += L.coarseCells;
+    res.stats.tiles += L.tiles;
+    res.stats.pixels += L.pixels;
   }
 
   // Brute force at sampled pixels: the measured error, and what a full brute-force image
@@ -820,21 +870,30 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     uint64_t dummyA = 0, dummyB = 0;
     auto tb = Clock::now();
     tbb::enumerable_thread_specific<EvalStats> bs;
-    Progress progress(o.referenceProgress, double(px.size()));
+    // A distributed render computes its share here (every pixel's colour depends only on
+    // the pixel) and gathers the rest.
+    auto mine = [&](size_t i) { return !share || share->ownsReference(i); };
+    size_t own = 0;
+    for (size_t i = 0; i < px.size(); ++i) own += mine(i);
+    Progress progress(o.referenceProgress, double(own));
     tbb::parallel_for(size_t(0), px.size(), [&](size_t i) {
+      if (!mine(i)) return;
       if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
       uint64_t a = 0, b = 0;
       ref[i] = renderPixel(scene, *brute, o, px[i].first, px[i].second, bs.local(), a, b).color;
       progress.add(1);
     });
     progress.finish();
+    for (const EvalStats& s : bs) bruteStats.add(s);
+    if (share && !(o.cancel && o.cancel->load())) share->gatherReference(ref, bruteStats);
     // Stopped during the reference: the image is whole, but the run is interrupted.
     if (o.cancel && o.cancel->load()) {
       res.interrupted = true;
       return res;
     }
     res.stats.reference.bruteSeconds = secondsSince(tb);
-    for (const EvalStats& s : bs) bruteStats.add(s);
+    res.stats.reference.localPixels = int(own);
+    if (share && !share->gathers()) return res;  // the gathering process reports the error
     // The error is that of the rendered image; the time, that of the method on these pixels
     // alone (under reconstruction cuts, the render's time per pixel).
     for (size_t i = 0; i < px.size(); ++i)

@@ -18,6 +18,8 @@
 
 namespace lc::render {
 
+class WorkShare;
+
 struct RenderOptions {
   int width = 512;
   int height = 512;
@@ -52,10 +54,14 @@ struct RenderOptions {
   // The same for the brute-force reference pixels (core/progress.h), called from any
   // worker thread, one at a time.
   ProgressFn referenceProgress = {};
+  // Shares the tiles and reference pixels with other processes (a distributed render,
+  // app/distributed.h); null: every tile and reference pixel is rendered here.
+  WorkShare* share = nullptr;
 };
 
 struct ReferenceStats {
   int pixels = 0;
+  int localPixels = 0;             // of those, computed by this process (a distributed render)
   double bruteSeconds = 0;         // time brute force took on the sampled pixels
   double bruteSecondsEstimate = 0; // extrapolated to the whole image
   double testSeconds = 0;          // time the tested method took on the same pixels
@@ -77,6 +83,9 @@ struct RenderStats {
   double seconds = 0;  // with the error floor's pre-pass
   float errorFloor = 0;  // the floor used (RenderOptions::errorFloor, resolved)
   uint64_t errorFloorPixels = 0;  // pixels of the automatic floor's pre-pass
+  double tileSeconds = 0;  // from the start until this process's last tile was rendered
+  uint64_t tiles = 0;      // tiles rendered here
+  uint64_t pixels = 0;     // pixels of those tiles
   uint64_t primaryRays = 0;
   uint64_t reconstructionSamples = 0;  // full lightcuts recorded as samples
   uint64_t reconstructionFallbacks = 0;  // primary hits whose samples did not match: full cuts
@@ -92,6 +101,56 @@ struct RenderResult {
   RenderStats stats;
   bool interrupted = false;
   std::vector<uint8_t> done;   // per pixel: 1 when rendered (an interrupted render is partial)
+};
+
+// A tile of the image: pixels [x0, x1) x [y0, y1).
+struct TileRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+// The tiles of one render, numbered in raster order. Their size depends on the options
+// (whole cells of reconstruction cuts), so every process of a distributed render, given
+// the same options, sees the same grid.
+struct TileGrid {
+  int width = 0, height = 0, tile = 16, tilesX = 0, tilesY = 0;
+  int count() const { return tilesX * tilesY; }
+  TileRect rect(int t) const;
+};
+TileGrid tileGrid(const RenderOptions& options, const lightcuts::LightEvaluator& evaluator);
+
+// Hands a render's tiles and reference pixels out over several processes and gathers them
+// on one (an MPI job, app/distributed.h; the renderer itself knows nothing of MPI). Every
+// pixel depends only on the scene, the options and its coordinates (reconstruction cuts'
+// samples on tile edges included), so the image does not depend on which process renders
+// which tile. render() asks next() from its worker threads until it gives -1, passes each
+// finished tile to rendered(), then calls endTiles(); on the gathering process the other
+// processes' tiles arrive in the result meanwhile.
+class WorkShare {
+ public:
+  virtual ~WorkShare() = default;
+  // Before the first tile. `result` (sized for the whole image) is where tiles rendered
+  // elsewhere are stored on the gathering process.
+  virtual void begin(const TileGrid& grid, RenderResult& result) = 0;
+  // The next tile to render here, or -1 when none is left (or on cancel). Called from any
+  // worker thread, concurrently; may wait for the tile to arrive.
+  virtual int next() = 0;
+  // Tile `tile` is rendered in `result` (its pixels, from `grid.rect(tile)`); called from
+  // the thread that rendered it. A tile left by a cancel is not passed on.
+  virtual void rendered(int tile, const RenderResult& result) = 0;
+  // Tiles done over all processes (0..1), for the progress bar.
+  virtual double fractionDone() const = 0;
+  // After this process's last tile: the gathering process waits for every tile (or a
+  // cancel); the others send theirs.
+  virtual void endTiles() = 0;
+  // Whether reference pixel i is computed here.
+  virtual bool ownsReference(size_t i) const = 0;
+  // After this process's reference pixels: the gathering process receives the others'
+  // colours into `reference` (by index) and adds their brute-force statistics to `brute`;
+  // the others send theirs.
+  virtual void gatherReference(std::vector<Color>& reference, lightcuts::EvalStats& brute) = 0;
+  // Whether this process gathers the image; elsewhere the result holds only the tiles
+  // rendered there, and the reference statistics are left out.
+  virtual bool gathers() const = 0;
 };
 
 RenderResult render(const scene::Scene& scene, const lightcuts::LightEvaluator& evaluator,
