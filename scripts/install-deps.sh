@@ -2,7 +2,7 @@
 # Installs the Debian packages lightcuts builds with, only when one is missing.
 # Idempotent: a second run with everything present touches nothing.
 #   scripts/install-deps.sh            # the build's packages (below)
-#   scripts/install-deps.sh PKG ...    # these packages instead (bench.sh, fuzz.sh)
+#   scripts/install-deps.sh PKG ...    # these packages instead (bench.sh, fuzz.sh, make report)
 set -euo pipefail
 pkgs=(
   build-essential cmake pkg-config
@@ -17,6 +17,7 @@ pkgs=(
   libgtest-dev         # GoogleTest: the test suite
   libbenchmark-dev     # Google Benchmark: micro benchmarks under bench/
   help2man             # the man page (lightcuts.1) from `lightcuts --help-all`; skipped without it
+  python3-markdown     # Python-Markdown: `make report` (scripts/report.py) turns docs/BENCHMARKS.md into HTML
 )
 if [ $# -gt 0 ]; then pkgs=("$@"); fi
 missing=()
