@@ -54,6 +54,7 @@ fuzz: deps
 
 # docs/BENCHMARKS.md (written by `make bench`) as one self-contained HTML page, images inlined.
 report:
+	@./scripts/install-deps.sh python3-markdown
 	@/usr/bin/python3 scripts/report.py -i docs/BENCHMARKS.md -o docs/report.html
 
 clean:

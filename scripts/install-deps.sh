@@ -2,7 +2,7 @@
 # Installs the Debian packages lightcuts builds with, only when one is missing.
 # Idempotent: a second run with everything present touches nothing.
 #   scripts/install-deps.sh            # the build's packages (below)
-#   scripts/install-deps.sh PKG ...    # these packages instead (bench.sh, fuzz.sh)
+#   scripts/install-deps.sh PKG ...    # these packages instead (bench.sh, fuzz.sh, make report)
 set -euo pipefail
 pkgs=(
   build-essential cmake pkg-config
@@ -19,6 +19,7 @@ pkgs=(
   help2man             # the man page (lightcuts.1) from `lightcuts --help-all`; skipped without it
   libopenmpi-dev       # Open MPI: distributed rendering over MPI (mpirun -np K lightcuts render ...; CMake LC_MPI)
   openmpi-bin          # Open MPI's mpirun: launching those jobs, and the MPI tests (src/app/distributed_test.cpp)
+  python3-markdown     # Python-Markdown: `make report` (scripts/report.py) turns docs/BENCHMARKS.md into HTML
 )
 if [ $# -gt 0 ]; then pkgs=("$@"); fi
 missing=()

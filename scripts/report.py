@@ -9,9 +9,9 @@ references to project issues ("(issue 3)", "(issues 2, 3)").
 
   /usr/bin/python3 scripts/report.py [-i docs/BENCHMARKS.md] [-o docs/report.html] [--all]
 
-Only the standard library is used. The Markdown understood is the subset these pages use:
-headings, paragraphs, lists, tables, fenced code, images, links, `code`, **bold**, *italic*,
-and raw HTML blocks (<details>, comments).
+The Markdown is converted by Python-Markdown (Debian's python3-markdown) with its tables,
+fenced_code and toc extensions; a small extension of ours strips the issue references from the
+headings, drops HTML comments, inlines the images and keeps only links to the web.
 """
 import argparse
 import base64
@@ -20,6 +20,16 @@ import mimetypes
 import os
 import re
 import sys
+import xml.etree.ElementTree as etree
+
+try:
+    import markdown
+    from markdown.extensions import Extension
+    from markdown.extensions.toc import TocExtension
+    from markdown.preprocessors import Preprocessor
+    from markdown.treeprocessors import Treeprocessor
+except ImportError:
+    sys.exit("report: Python-Markdown is missing: scripts/install-deps.sh python3-markdown")
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -63,13 +73,9 @@ def strip_issue_refs(title):
     return t.strip()
 
 
-def slug(text, used):
-    s = re.sub(r"[^a-z0-9]+", "-", re.sub(r"<[^>]+>", "", text).lower()).strip("-") or "section"
-    base, n = s, 2
-    while s in used:
-        s, n = f"{base}-{n}", n + 1
-    used.add(s)
-    return s
+def slug(text, separator="-"):
+    """A heading's id: 'The seed's table (512×512)' -> 'the-seed-s-table-512-512' (toc's slugify)."""
+    return re.sub(r"[^a-z0-9]+", separator, text.lower()).strip(separator) or "section"
 
 
 def user_section(text):
@@ -85,138 +91,97 @@ def data_uri(path):
         return f"data:{mime};base64," + base64.b64encode(f.read()).decode("ascii")
 
 
-class Converter:
+class ReportExtension(Extension):
+    """What the page needs beyond Python-Markdown's own: headings without issue references, no
+    HTML comments, images inlined as data URIs, and no links but to the web (a relative link
+    keeps its text: the page stands alone)."""
+
     def __init__(self, base_dir):
+        super().__init__()
         self.base = base_dir
         self.missing = []
-        self.headings = []  # (level, id, html) of every h2 and h3, for the table of contents
-        self.ids = set()
 
-    def image(self, alt, src):
+    def extendMarkdown(self, md):
+        # before fenced_code (25) and the raw-HTML block (20); after the inline patterns (20)
+        md.preprocessors.register(_Headings(md), "lc_headings", 35)
+        md.treeprocessors.register(_ImagesAndLinks(md, self), "lc_images", 15)
+
+
+class _Headings(Preprocessor):
+    def run(self, lines):
+        out, fence, comment = [], False, False
+        for line in lines:
+            s = line.strip()
+            if comment:
+                comment = "-->" not in line
+                continue
+            if s.startswith("```"):
+                fence = not fence
+            elif not fence and s.startswith("<!--"):
+                comment = "-->" not in line
+                continue
+            elif not fence and (m := re.match(r"^(#{1,6})\s+(.*)$", s)):
+                line = f"{m.group(1)} {strip_issue_refs(m.group(2))}"
+            out.append(line)
+        return out
+
+
+class _ImagesAndLinks(Treeprocessor):
+    def __init__(self, md, ext):
+        super().__init__(md)
+        self.ext = ext
+
+    def run(self, root):
+        for parent in list(root.iter()):
+            for i, el in enumerate(list(parent)):
+                if el.tag == "img":
+                    self.image(parent, i, el)
+                elif el.tag == "a" and not re.match(r"^https?://", el.get("href", "")):
+                    self.unwrap(el)
+
+    def image(self, parent, i, el):
+        src, alt = el.get("src", ""), el.get("alt", "")
         if re.match(r"^[a-z]+:", src):
             # never reference anything outside the page
-            return f"<em>[image: {html.escape(alt)}]</em>"
-        path = os.path.normpath(os.path.join(self.base, src))
+            self.replace(parent, i, el, f"[image: {alt}]")
+            return
+        path = os.path.normpath(os.path.join(self.ext.base, src))
         if not os.path.exists(path):
-            self.missing.append(src)
-            return f"<em>[missing image: {html.escape(src)}]</em>"
-        return f'<img alt="{html.escape(alt, quote=True)}" src="{data_uri(path)}">'
-
-    def inline(self, text):
-        out = []
-        # split off code spans first: nothing inside them is interpreted
-        for i, part in enumerate(re.split(r"(`[^`]*`)", text)):
-            if i % 2 == 1:
-                out.append("<code>" + html.escape(part[1:-1]) + "</code>")
-                continue
-            pieces = []
-            pos = 0
-            for m in re.finditer(r"!\[([^\]]*)\]\(([^)\s]+)\)|\[([^\]]+)\]\(([^)\s]+)\)", part):
-                pieces.append(self.emphasis(html.escape(part[pos:m.start()], quote=False)))
-                if m.group(2) is not None:
-                    pieces.append(self.image(m.group(1), m.group(2)))
-                else:
-                    label, href = self.emphasis(html.escape(m.group(3), quote=False)), m.group(4)
-                    if re.match(r"^https?://", href):
-                        pieces.append(f'<a href="{html.escape(href, quote=True)}">{label}</a>')
-                    else:
-                        pieces.append(f"{label}")
-                pos = m.end()
-            pieces.append(self.emphasis(html.escape(part[pos:], quote=False)))
-            out.append("".join(pieces))
-        return "".join(out)
+            self.ext.missing.append(src)
+            self.replace(parent, i, el, f"[missing image: {src}]")
+            return
+        el.set("src", data_uri(path))
 
     @staticmethod
-    def emphasis(s):
-        s = re.sub(r"\*\*(.+?)\*\*", r"<strong>\1</strong>", s)
-        s = re.sub(r"(?<![\w*])\*(?!\s)(.+?)(?<!\s)\*(?![\w*])", r"<em>\1</em>", s)
-        return s
+    def replace(parent, i, el, text):
+        em = etree.Element("em")
+        em.text, em.tail = text, el.tail
+        parent.remove(el)
+        parent.insert(i, em)
 
-    def table(self, lines):
-        def cells(line):
-            line = line.strip()
-            if line.startswith("|"):
-                line = line[1:]
-            if line.endswith("|"):
-                line = line[:-1]
-            return [c.strip() for c in line.split("|")]
+    @staticmethod
+    def unwrap(el):
+        """<a href="x">label</a> -> label (a <span>, which keeps the label's markup and tail)."""
+        el.tag = "span"
+        el.attrib.clear()
 
-        head = cells(lines[0])
-        out = ["<table>", "<thead><tr>" + "".join(f"<th>{self.inline(c)}</th>" for c in head) + "</tr></thead>",
-               "<tbody>"]
-        for line in lines[2:]:
-            out.append("<tr>" + "".join(f"<td>{self.inline(c)}</td>" for c in cells(line)) + "</tr>")
-        out.append("</tbody></table>")
-        return "\n".join(out)
 
-    def convert(self, text):
-        lines = text.splitlines()
-        out = []
-        i = 0
-        para = []
+def convert(text, base_dir):
+    """(body HTML, h2 and h3 headings as (level, id, title), missing images) of the Markdown."""
+    ext = ReportExtension(base_dir)
+    md = markdown.Markdown(extensions=["tables", "fenced_code", ext,
+                                       TocExtension(slugify=slug, toc_depth="2-3")])
+    body = md.convert(text)
+    headings = []
 
-        def flush():
-            if para:
-                out.append("<p>" + self.inline(" ".join(para)) + "</p>")
-                para.clear()
+    def walk(tokens):
+        for t in tokens:
+            if t["level"] in (2, 3):
+                headings.append((t["level"], t["id"], t["name"]))
+            walk(t["children"])
 
-        while i < len(lines):
-            line = lines[i]
-            s = line.strip()
-            if not s:
-                flush()
-                i += 1
-            elif s.startswith("```"):
-                flush()
-                j = i + 1
-                while j < len(lines) and not lines[j].strip().startswith("```"):
-                    j += 1
-                out.append("<pre><code>" + html.escape("\n".join(lines[i + 1:j])) + "</code></pre>")
-                i = j + 1
-            elif s.startswith("<!--"):
-                flush()
-                while i < len(lines) and "-->" not in lines[i]:
-                    i += 1
-                i += 1
-            elif re.match(r"^</?(details|summary|div|br)\b", s):
-                flush()
-                out.append(s)
-                i += 1
-            elif m := re.match(r"^(#{1,6})\s+(.*)$", s):
-                flush()
-                n = len(m.group(1))
-                title = self.inline(strip_issue_refs(m.group(2)))
-                hid = slug(title, self.ids)
-                if n in (2, 3):
-                    self.headings.append((n, hid, title))
-                out.append(f'<h{n} id="{hid}">{title}</h{n}>')
-                i += 1
-            elif s.startswith("|") and i + 1 < len(lines) and re.match(r"^\|?\s*:?-{3,}", lines[i + 1].strip()):
-                flush()
-                j = i
-                while j < len(lines) and lines[j].strip().startswith("|"):
-                    j += 1
-                out.append(self.table(lines[i:j]))
-                i = j
-            elif re.match(r"^([-*]|\d+\.)\s+", s):
-                flush()
-                ordered = bool(re.match(r"^\d+\.", s))
-                items = []
-                while i < len(lines) and lines[i].strip():
-                    t = lines[i].strip()
-                    m = re.match(r"^([-*]|\d+\.)\s+(.*)$", t)
-                    if m and not lines[i].startswith("    "):
-                        items.append(m.group(2))
-                    elif items:
-                        items[-1] += " " + t
-                    i += 1
-                tag = "ol" if ordered else "ul"
-                out.append(f"<{tag}>" + "".join(f"<li>{self.inline(x)}</li>" for x in items) + f"</{tag}>")
-            else:
-                para.append(s)
-                i += 1
-        flush()
-        return "\n".join(out)
+    walk(md.toc_tokens)
+    return body, headings, ext.missing
 
 
 def toc_html(headings):
@@ -241,9 +206,9 @@ def main(argv=None):
     if not os.path.exists(a.input):
         sys.exit(f"report: {a.input} not found (run `make bench` first)")
     text = open(a.input, encoding="utf-8").read()
-    conv = Converter(os.path.dirname(os.path.abspath(a.input)))
-    body = conv.convert(text if a.all else user_section(text))
-    toc = toc_html(conv.headings)
+    body, headings, missing = convert(text if a.all else user_section(text),
+                                      os.path.dirname(os.path.abspath(a.input)))
+    toc = toc_html(headings)
     docs = " · ".join(f'<a href="{href}" title="{html.escape(what, quote=True)}">{html.escape(name)}</a>'
                       for href, name, what in DOC_LINKS)
     intro = (f"<h1>{html.escape(a.title)}</h1>\n"
@@ -266,10 +231,10 @@ def main(argv=None):
     with open(tmp, "w", encoding="utf-8") as f:
         f.write(page)
     os.replace(tmp, a.output)
-    for m in conv.missing:
+    for m in missing:
         print(f"report: warning: image not found: {m}", file=sys.stderr)
     print(f"report: wrote {a.output} ({len(page) / 1024:.0f} KiB)")
-    return 1 if conv.missing else 0
+    return 1 if missing else 0
 
 
 if __name__ == "__main__":
