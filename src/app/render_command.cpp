@@ -44,7 +44,7 @@ struct RenderArgs {
   std::string method = "lightcuts";
   std::string tree;  // default: by method
   float error = -1;  // default: by method
-  int maxCut = 4000;
+  int maxCut = lightcuts::CutOptions{}.maxCut;
   int stochasticCut = lightcuts::CutOptions{}.stochasticCut;
   std::string criterion = "total";
   std::string estimator = "first-order";
@@ -60,12 +60,9 @@ struct RenderArgs {
   LoadOptions load;
 };
 
-// The seed's traversal compares an error radius with the distance to the point, not a
-// relative bound, so its threshold has its own default; the seed did not publish its value,
-// and 0.25 gives the default Cornell box about the cut the seed reported (257 vs 273.6
-// lights per pixel).
-constexpr float kLightcutsDefaultError = 0.02f;
-constexpr float kSeedDefaultError = 0.25f;
+// --error's defaults live with the cut options (lightcuts/evaluator.h).
+constexpr float kLightcutsDefaultError = lightcuts::CutOptions{}.errorRatio;
+constexpr float kSeedDefaultError = lightcuts::kSeedCutsDefaultError;
 
 // --reconstruct auto: reconstruction cuts (every 4 pixels) from 512 x 512 pixels up, a
 // full lightcut at every point below. A cell of 4 x 4 pixels covers four times the

@@ -49,6 +49,12 @@ enum class CutCriterion { Walter, Total };
 CutCriterion parseCutCriterion(const std::string& name);  // "walter" | "total"
 const char* cutCriterionName(CutCriterion c);
 
+// The seed's traversal compares an error radius with the distance to the point, not a
+// relative bound, so its --error has its own default; the seed did not publish its value,
+// and 0.25 gives the default Cornell box about the cut the seed reported (257 vs 273.6
+// lights per pixel).
+constexpr float kSeedCutsDefaultError = 0.25f;
+
 struct CutOptions {
   float errorRatio = 0.02f;  // --error: relative error threshold
   int maxCut = 4000;         // --max-cut: most nodes in one cut
