@@ -106,6 +106,8 @@ TEST(FuzzRegression, KnownBadImagesAreRefusedClearly) {
       {"jpeg_progressive_shift.jpg", "corrupt JPEG (51 extraneous bytes before marker 0xdb)"},
       {"jpeg_undefined_huffman_table.jpg", "corrupt JPEG (63 extraneous bytes before marker 0xc2)"},
       {"png_empty_idat.png", "corrupt PNG (IHDR: CRC error)"},
+      // libpng allocated its row buffers (3 GB) before the size was checked.
+      {"png_row_buffers_before_size_check.png", ""},
   };
   size_t refused = 0;
   for (const std::string& f : inputsOf("image")) {
@@ -120,7 +122,10 @@ TEST(FuzzRegression, KnownBadImagesAreRefusedClearly) {
       lc::io::readImage(f);
       ADD_FAILURE() << "read";
     } catch (const lc::Error& e) {
-      EXPECT_EQ(std::string(e.what()), "cannot read image '" + f + "': " + reasons.at(name));
+      if (reasons.at(name).empty())
+        EXPECT_EQ(std::string(e.what()), "image '" + f + "' is 989855746x2 = 1979711492 pixels, more than the limit of 268435456");
+      else
+        EXPECT_EQ(std::string(e.what()), "cannot read image '" + f + "': " + reasons.at(name));
       ++refused;
     }
   }

@@ -180,7 +180,7 @@ const std::array<float, 256>& srgbTable() {
 
 // libpng and libjpeg report errors through a callback that must not return: it longjmps back
 // to the setjmp of the function that called into the library. The functions holding a setjmp
-// (pngHeader, pngPixels, jpegDecode) keep only plain data in their frames; every C++ object
+// (pngInfo, pngSetup, pngPixels, jpegHeader, jpegPixels) keep only plain data in their frames; every C++ object
 // (the pixel buffers, the Image) belongs to their callers, so a jump skips no destructor. The
 // library structs are freed by PngRead's / JpegRead's destructors on every path.
 
@@ -209,15 +209,22 @@ void pngReadData(png_structp png, png_bytep data, size_t n) {
   }
 }
 
-// Reads the chunks up to the image data and sets the transforms that give what stb_image
-// gave when asked for 3 channels: palette -> RGB, grey of 1/2/4 bits -> 8 bits (scaled to
-// 0..255), grey -> RGB, alpha (and tRNS) dropped; 8 and 16 bits stay as they are (16-bit
-// samples big-endian). No gamma or colour-space transform (stb applied none).
-bool pngHeader(PngRead& r) {
+// Reads the chunks up to the image data (the size is then known: the caller checks it before
+// pngSetup, whose png_read_update_info allocates row buffers).
+bool pngInfo(PngRead& r) {
   if (setjmp(png_jmpbuf(r.png))) return false;
   // libpng's default caps each side at 10^6; the caller's pixel limit is the one to apply.
   png_set_user_limits(r.png, PNG_UINT_31_MAX, PNG_UINT_31_MAX);
   png_read_info(r.png, r.info);
+  return true;
+}
+
+// The transforms that give what stb_image gave when asked for 3 channels: palette -> RGB, grey
+// of 1/2/4 bits -> 8 bits (scaled to 0..255), grey -> RGB, alpha (and tRNS) dropped; 8 and 16
+// bits stay as they are (16-bit samples big-endian). No gamma or colour-space transform (stb
+// applied none).
+bool pngSetup(PngRead& r) {
+  if (setjmp(png_jmpbuf(r.png))) return false;
   const int colorType = png_get_color_type(r.png, r.info), depth = png_get_bit_depth(r.png, r.info);
   if (colorType == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(r.png);
   if (colorType == PNG_COLOR_TYPE_GRAY && depth < 8) png_set_expand_gray_1_2_4_to_8(r.png);
@@ -242,6 +249,11 @@ Image readPng(const std::string& path, FILE* f, bool srgb, uint64_t maxPixels) {
   if (r.png) r.info = png_create_info_struct(r.png);
   if (!r.png || !r.info) throwDecode(path, "out of memory (libpng)");
   png_set_read_fn(r.png, &r, pngReadData);
+#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+  // Fuzz builds only (CMakeLists.txt): a mutated PNG would almost always stop at a checksum.
+  png_set_crc_action(r.png, PNG_CRC_QUIET_USE, PNG_CRC_QUIET_USE);
+  png_set_option(r.png, PNG_IGNORE_ADLER32, PNG_OPTION_ON);
+#endif
   auto fail = [&]() {
     // A size that IHDR gave is reported against the limit even when a later chunk is bad.
     const uint32_t w = png_get_image_width(r.png, r.info), h = png_get_image_height(r.png, r.info);
@@ -249,9 +261,10 @@ Image readPng(const std::string& path, FILE* f, bool srgb, uint64_t maxPixels) {
     if (r.truncated) throwDecode(path, "truncated PNG: the file ends before the image data does");
     throwDecode(path, std::string("corrupt PNG (") + r.message + ")");
   };
-  if (!pngHeader(r)) fail();
+  if (!pngInfo(r)) fail();
   const uint32_t w = png_get_image_width(r.png, r.info), h = png_get_image_height(r.png, r.info);
   checkSize(path, int(w), int(h), maxPixels);  // libpng caps both at 2^31 - 1
+  if (!pngSetup(r)) fail();
   const int depth = png_get_bit_depth(r.png, r.info);
   const size_t rowBytes = png_get_rowbytes(r.png, r.info);
   if (png_get_channels(r.png, r.info) != 3 || (depth != 8 && depth != 16) ||

@@ -652,7 +652,7 @@ TEST(ImagePng, TruncatedAndCorruptAreRefusedNamingTheFile) {
 
 // A JPEG written by libjpeg itself (CMYK needs it: stb_image_write writes YCbCr only).
 std::vector<uint8_t> makeJpeg(int w, int h, int comps, J_COLOR_SPACE in, J_COLOR_SPACE out,
-                              const std::vector<uint8_t>& px, bool progressive = false) {
+                              const std::vector<uint8_t>& px, bool progressive = false, bool arithmetic = false) {
   jpeg_compress_struct c{};
   jpeg_error_mgr err{};
   c.err = jpeg_std_error(&err);
@@ -669,6 +669,7 @@ std::vector<uint8_t> makeJpeg(int w, int h, int comps, J_COLOR_SPACE in, J_COLOR
   jpeg_set_quality(&c, 100, TRUE);
   for (int i = 0; i < c.num_components; ++i) c.comp_info[i].h_samp_factor = c.comp_info[i].v_samp_factor = 1;
   if (progressive) jpeg_simple_progression(&c);
+  c.arith_code = arithmetic ? TRUE : FALSE;
   jpeg_start_compress(&c, TRUE);
   while (c.next_scanline < c.image_height) {
     JSAMPROW row = const_cast<uint8_t*>(&px[size_t(c.next_scanline) * size_t(w * comps)]);
@@ -786,6 +787,26 @@ TEST(ImageJpeg, TruncatedAndCorruptAreRefusedNamingTheFile) {
   writeRaw(dir.file("x.jpg"), {0xFF, 0xD9, 0xFF, 0x00, 0x01});
   EXPECT_EQ(readError(dir.file("x.jpg")),
             "cannot read image '" + dir.file("x.jpg") + "': corrupt JPEG (Not a JPEG file: starts with 0xff 0xd9)");
+}
+
+TEST(ImageJpeg, ArithmeticCodingReadsTwelveBitIsRefused) {
+  TempDir dir;
+  std::vector<uint8_t> grey(64 * 8);
+  for (size_t i = 0; i < grey.size(); ++i) grey[i] = uint8_t(i % 64 < 32 ? 50 : 180);
+  // Arithmetic-coded (stb_image refused these): decodes.
+  writeRaw(dir.file("a.jpg"), makeJpeg(64, 8, 1, JCS_GRAYSCALE, JCS_GRAYSCALE, grey, false, true));
+  Image a = readImage(dir.file("a.jpg"));
+  EXPECT_NEAR(a.at(3, 3).y * 255.0f, 50.0f, 1.0f);
+  EXPECT_NEAR(a.at(60, 3).y * 255.0f, 180.0f, 1.0f);
+  // The frame header says 12 bits per sample: refused, saying why.
+  std::vector<uint8_t> jpg = makeJpeg(64, 8, 1, JCS_GRAYSCALE, JCS_GRAYSCALE, grey);
+  size_t sof = 2;
+  while (sof + 4 < jpg.size() && !(jpg[sof] == 0xFF && jpg[sof + 1] == 0xC0)) ++sof;
+  ASSERT_LT(sof + 4, jpg.size());
+  jpg[sof + 4] = 12;
+  writeRaw(dir.file("p12.jpg"), jpg);
+  EXPECT_EQ(readError(dir.file("p12.jpg")), "cannot read image '" + dir.file("p12.jpg") +
+                                                "': JPEG feature not supported (Unsupported JPEG data precision 12)");
 }
 
 // The decoders agree with stb_image on the valid PNG and JPEG files of the repository (the
