@@ -106,6 +106,7 @@ TEST(FuzzRegression, KnownBadImagesAreRefusedClearly) {
       {"jpeg_progressive_shift.jpg", "corrupt JPEG (51 extraneous bytes before marker 0xdb)"},
       {"jpeg_undefined_huffman_table.jpg", "corrupt JPEG (63 extraneous bytes before marker 0xc2)"},
       {"png_empty_idat.png", "corrupt PNG (IHDR: CRC error)"},
+      {"pnm_header_int_overflow.pgm", "bad PNM header (a number larger than 2147483647)"},
       // libpng allocated its row buffers (3 GB) before the size was checked.
       {"png_row_buffers_before_size_check.png", ""},
   };

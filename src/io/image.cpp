@@ -487,8 +487,9 @@ bool hdrDecodeTerminates(const std::vector<uint8_t>& b) {
   return true;
 }
 
-// Binary PNM with 16-bit samples (P5/P6, maxval > 255). stb_image 2.27 gets these wrong
-// twice: it converts them to the requested channel count as if they were 8-bit, returning a
+// Binary PNM (P5/P6): the header's numbers are read here first, for every such file, and
+// refused above 2^31-1 (stb_image's int overflows). With 16-bit samples (maxval > 255),
+// stb_image 2.27 goes wrong twice: it converts them to the requested channel count as if they were 8-bit, returning a
 // buffer half the size it should be (a heap overflow when read: found by the image fuzz
 // target, data/regressions/image/pnm16_channel_conversion.pgm), and it does not swap the
 // big-endian samples. They are decoded here instead: value / maxval. Returns false (and
@@ -512,6 +513,9 @@ bool readPnm16(const std::string& path, const std::vector<uint8_t>& b, bool srgb
       v = std::min<uint64_t>(v * 10 + uint64_t(b[p] - '0'), uint64_t(1) << 40);
       ++p;
     }
+    // stb_image parses the same numbers into an int, overflowing (UB; found by fuzzing).
+    if (v > uint64_t(std::numeric_limits<int>::max()))
+      throwDecode(path, "bad PNM header (a number larger than 2147483647)");
     return true;
   };
   uint64_t w = 0, h = 0, maxval = 0;
