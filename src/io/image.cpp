@@ -180,9 +180,9 @@ const std::array<float, 256>& srgbTable() {
 
 // libpng and libjpeg report errors through a callback that must not return: it longjmps back
 // to the setjmp of the function that called into the library. The functions holding a setjmp
-// (pngInfo, pngSetup, pngPixels, jpegHeader, jpegPixels) keep only plain data in their frames; every C++ object
-// (the pixel buffers, the Image) belongs to their callers, so a jump skips no destructor. The
-// library structs are freed by PngRead's / JpegRead's destructors on every path.
+// (pngInfo, pngSetup, pngPixels, jpegHeader, jpegPixels) keep only plain data in their frames;
+// every C++ object (the pixel buffers, the Image) belongs to their callers, so a jump skips no
+// destructor. The library structs are freed by PngRead's / JpegRead's destructors on every path.
 
 // ---- PNG: libpng ----------------------------------------------------------------------------
 
@@ -190,6 +190,7 @@ struct PngRead {
   png_structp png = nullptr;
   png_infop info = nullptr;
   FILE* file = nullptr;
+  int passes = 1;          // 7 for an interlaced PNG
   bool truncated = false;  // the read callback hit the end of the file
   char message[256] = "";
   ~PngRead() { png_destroy_read_struct(&png, info ? &info : nullptr, nullptr); }
@@ -230,14 +231,17 @@ bool pngSetup(PngRead& r) {
   if (colorType == PNG_COLOR_TYPE_GRAY && depth < 8) png_set_expand_gray_1_2_4_to_8(r.png);
   if (colorType == PNG_COLOR_TYPE_GRAY || colorType == PNG_COLOR_TYPE_GRAY_ALPHA) png_set_gray_to_rgb(r.png);
   png_set_strip_alpha(r.png);
-  png_set_interlace_handling(r.png);
+  r.passes = png_set_interlace_handling(r.png);
   png_read_update_info(r.png, r.info);
   return true;
 }
 
-bool pngPixels(PngRead& r, png_bytep* rows) {
+// Row by row into the caller's buffer (no array of row pointers: as many as the rows); an
+// interlaced image passes over the rows once per pass.
+bool pngPixels(PngRead& r, uint8_t* data, size_t rowBytes, uint32_t height) {
   if (setjmp(png_jmpbuf(r.png))) return false;
-  png_read_image(r.png, rows);
+  for (int pass = 0; pass < r.passes; ++pass)
+    for (uint32_t y = 0; y < height; ++y) png_read_row(r.png, data + y * rowBytes, nullptr);
   png_read_end(r.png, nullptr);  // through IEND: the last CRC, and a file cut after the data
   return true;
 }
@@ -272,9 +276,7 @@ Image readPng(const std::string& path, FILE* f, bool srgb, uint64_t maxPixels) {
     throwDecode(path, "PNG layout not handled (" + std::to_string(png_get_channels(r.png, r.info)) +
                           " channels of " + std::to_string(depth) + " bits after expansion)");
   std::vector<uint8_t> data(rowBytes * h);
-  std::vector<png_bytep> rows(h);
-  for (size_t y = 0; y < h; ++y) rows[y] = data.data() + y * rowBytes;
-  if (!pngPixels(r, rows.data())) fail();
+  if (!pngPixels(r, data.data(), rowBytes, h)) fail();
 
   Image img(static_cast<int>(w), static_cast<int>(h));
   const auto& table = srgbTable();
@@ -298,17 +300,15 @@ struct JpegRead {
   jpeg_error_mgr err{};
   jpeg_progress_mgr progress{};
   std::jmp_buf jump{};
-  bool created = false;
   bool truncated = false;  // libjpeg's source reached the end of the file
   char message[JMSG_LENGTH_MAX] = "";
-  ~JpegRead() {
-    if (created) jpeg_destroy_decompress(&cinfo);
-  }
+  // Safe whether or not jpeg_create_decompress ran or finished: it frees what cinfo.mem holds.
+  ~JpegRead() { jpeg_destroy_decompress(&cinfo); }
 };
 
 // A progressive JPEG may hold any number of scans, and each one passes over the whole image:
-// a small file can keep the decoder busy for hours (libjpeg-turbo's advice for untrusted input,
-// djpeg -maxscans). Real encoders write about 10.
+// a small file can keep the decoder busy for hours (djpeg -maxscans guards against the same).
+// Real encoders write about 10.
 constexpr int kMaxJpegScans = 1000;
 
 [[noreturn]] void jpegFail(j_common_ptr c) {
@@ -342,7 +342,6 @@ struct JpegHeader {
 bool jpegHeader(JpegRead& r, FILE* f, JpegHeader& h) {
   if (setjmp(r.jump)) return false;
   jpeg_create_decompress(&r.cinfo);
-  r.created = true;
   r.cinfo.progress = &r.progress;
   jpeg_stdio_src(&r.cinfo, f);
   jpeg_read_header(&r.cinfo, TRUE);
