@@ -341,6 +341,22 @@ std::vector<Row> catalogue() {
     rows.push_back(r);
   }
   {
+    // Issue 30: PNG and JPEG textures are read by libpng and libjpeg-turbo; a cut file is an
+    // error naming it, not a texture filled with grey.
+    Row r = ray("truncated_png_texture", "sphere { material = { diffuse = map(\"cut.png\"); }; }",
+                "truncated_png_texture.ray:2:33: error: cannot read texture 'cut.png': truncated PNG: the file "
+                "ends before the image data does");
+    r.files.push_back({"cut.png", std::string("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0", 18)});
+    rows.push_back(r);
+  }
+  {
+    Row r = ray("truncated_jpeg_texture", "sphere { material = { diffuse = map(\"cut.jpg\"); }; }",
+                "truncated_jpeg_texture.ray:2:33: error: cannot read texture 'cut.jpg': truncated JPEG: the file "
+                "ends before the image data does");
+    r.files.push_back({"cut.jpg", std::string("\xff\xd8\xff\xdb\x00\x43\x00", 7)});
+    rows.push_back(r);
+  }
+  {
     Row r;
     r.name = "unreadable_image";
     r.files = {{"junk.png", "@junk"}, {"b.ppm", "P6\n1 1\n255\nabc"}};
