@@ -1,5 +1,5 @@
-// libFuzzer target: image decoding (io::readImage: EXR via OpenEXR, everything else via
-// stb_image), with the texture pixel limit small.
+// libFuzzer target: image decoding (io::readImage: EXR via OpenEXR, PNG via libpng, JPEG via
+// libjpeg-turbo, BMP/TGA/PNM/HDR via stb_image), with the texture pixel limit small.
 #include "fuzz_entry.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {

@@ -58,6 +58,7 @@ for t in "${targets[@]}"; do
   case "$t" in
     ray_parser | scene) dict=(-dict="$root/fuzz/dict/ray.dict") ;;
     obj_loader) dict=(-dict="$root/fuzz/dict/obj.dict") ;;
+    image) dict=(-dict="$root/fuzz/dict/image.dict") ;;
   esac
   log="$build/logs/$t.log"
   before=$(find "$art" -type f | wc -l)

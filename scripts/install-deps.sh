@@ -8,7 +8,9 @@ pkgs=(
   build-essential cmake pkg-config
   libembree-dev        # Embree 3: every ray query (BVH build, intersection, occlusion)
   libtbb-dev           # oneTBB: parallel tiles, parallel light placement and VPLs
-  libstb-dev           # stb_image / stb_image_write / stb_easy_font: textures, PNG/BMP output, legends
+  libpng-dev           # libpng: PNG textures and images (decoding)
+  libjpeg62-turbo-dev  # libjpeg-turbo: JPEG textures (decoding)
+  libstb-dev           # stb_image / stb_image_write / stb_easy_font: BMP/TGA/PNM/HDR textures, PNG/BMP output, legends
   libcli11-dev         # CLI11: the command line
   libfmt-dev           # fmt: formatting of messages and reports
   libopenexr-dev       # OpenEXR: float images (reference renders, partial output)

@@ -344,6 +344,22 @@ std::vector<Row> catalogue() {
     rows.push_back(r);
   }
   {
+    // Issue 30: PNG and JPEG textures are read by libpng and libjpeg-turbo; a cut file is an
+    // error naming it, not a texture filled with grey.
+    Row r = ray("truncated_png_texture", "sphere { material = { diffuse = map(\"cut.png\"); }; }",
+                "truncated_png_texture.ray:2:33: error: cannot read texture 'cut.png': truncated PNG: the file "
+                "ends before the image data does");
+    r.files.push_back({"cut.png", std::string("\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR\0\0", 18)});
+    rows.push_back(r);
+  }
+  {
+    Row r = ray("truncated_jpeg_texture", "sphere { material = { diffuse = map(\"cut.jpg\"); }; }",
+                "truncated_jpeg_texture.ray:2:33: error: cannot read texture 'cut.jpg': truncated JPEG: the file "
+                "ends before the image data does");
+    r.files.push_back({"cut.jpg", std::string("\xff\xd8\xff\xdb\x00\x43\x00", 7)});
+    rows.push_back(r);
+  }
+  {
     Row r;
     r.name = "unreadable_image";
     r.files = {{"junk.png", "@junk"}, {"b.ppm", "P6\n1 1\n255\nabc"}};
@@ -875,6 +891,11 @@ TEST(CliLimitsRender, VplsFromTheCommandLine) {
 TEST(CliLimitsMemory, EachConsumerIsCountedAgainstOneBudget) {
   TempDir dir;
   fs::copy_file(lc::testing::dataPath("models/cube.obj"), dir.file("cube.obj"));
+  fs::copy_file(lc::testing::dataPath("public-scenes/checkerboard.bmp"), dir.file("a.bmp"));
+  fs::copy_file(lc::testing::dataPath("public-scenes/checkerboard.bmp"), dir.file("b.bmp"));
+  // Two textures: each fits the budget alone, both do not (counted across files).
+  writeText(dir.file("tex.ray"), kHeader + "sphere { material = { diffuse = map(\"a.bmp\"); }; }\n"
+                                           "sphere { material = { diffuse = map(\"b.bmp\"); }; }\n");
   writeText(dir.file("items.ray"), kHeader + "sphere {} sphere {} sphere {} sphere {}\n");
   writeText(dir.file("obj.ray"), kHeader + "obj_mesh { file = \"cube.obj\"; }\n");
   writeText(dir.file("lum.ray"),
@@ -893,6 +914,9 @@ TEST(CliLimitsMemory, EachConsumerIsCountedAgainstOneBudget) {
       {{"info", "lum.ray"}, "600K", "800K",
        "lum.ray:2:23: error: the 2000 lights of luminous objects need about 625.0 KB, more than --max-memory "
        "(600.0 KB)"},
+      {{"info", "tex.ray"}, "6M", "12M",
+       "tex.ray:3:33: error: the 542x538 pixels of 'b.bmp' need about 4.4 MB (8.9 MB with what is already loaded), "
+       "more than --max-memory (6.0 MB)"},
       {{"info", "vpl.ray", "--vpls", "1000"}, "300K", "400K",
        "1000 VPLs need about 312.5 KB, more than --max-memory (300.0 KB)"},
       {{"render", "vpl.ray", "-o", "i.png", "-q", "--width", "100", "--height", "100"}, "300K", "400K",

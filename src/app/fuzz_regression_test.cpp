@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -111,6 +112,43 @@ TEST(FuzzRegression, SixteenBitPnmKeepsItsValues) {
   EXPECT_FLOAT_EQ(c.pixels[0].x, 0.0f);
   EXPECT_FLOAT_EQ(c.pixels[0].y, float(0x8000) / 65535.0f);
   EXPECT_FLOAT_EQ(c.pixels[0].z, 1.0f);
+}
+
+// Each known-bad image is refused with a message that names the file and says what is wrong
+// (since issue 30 the JPEGs and the PNG by libjpeg-turbo and libpng, not by guards before stb).
+TEST(FuzzRegression, KnownBadImagesAreRefusedClearly) {
+  const std::map<std::string, std::string> reasons = {
+      {"hdr_rle_zero_count.hdr", "corrupt HDR (bad run-length data)"},
+      {"jpeg_dht_overflow.jpg", "corrupt JPEG (Bogus Huffman table definition)"},
+      {"jpeg_dht_overflow_fill_bytes.jpg", "corrupt JPEG (Not a JPEG file: starts with 0xff 0xff)"},
+      {"jpeg_progressive_shift.jpg", "corrupt JPEG (51 extraneous bytes before marker 0xdb)"},
+      {"jpeg_undefined_huffman_table.jpg", "corrupt JPEG (63 extraneous bytes before marker 0xc2)"},
+      {"png_empty_idat.png", "corrupt PNG (IHDR: CRC error)"},
+      {"pnm_header_int_overflow.pgm", "bad PNM header (a number larger than 2147483647)"},
+      // libpng allocated its row buffers (3 GB) before the size was checked.
+      {"png_row_buffers_before_size_check.png", ""},
+  };
+  size_t refused = 0;
+  for (const std::string& f : inputsOf("image")) {
+    SCOPED_TRACE(f);
+    const std::string name = fs::path(f).filename().string();
+    if (name == "pnm16_channel_conversion.pgm") {  // a valid 16-bit PGM: it reads (1x8)
+      EXPECT_EQ(lc::io::readImage(f).height, 8);
+      continue;
+    }
+    ASSERT_EQ(reasons.count(name), 1u) << "add the expected message of " << name;
+    try {
+      lc::io::readImage(f);
+      ADD_FAILURE() << "read";
+    } catch (const lc::Error& e) {
+      if (reasons.at(name).empty())
+        EXPECT_EQ(std::string(e.what()), "image '" + f + "' is 989855746x2 = 1979711492 pixels, more than the limit of 268435456");
+      else
+        EXPECT_EQ(std::string(e.what()), "cannot read image '" + f + "': " + reasons.at(name));
+      ++refused;
+    }
+  }
+  EXPECT_EQ(refused, reasons.size());
 }
 
 TEST(FuzzRegression, RefusedFormatsSayWhy) {

@@ -7,12 +7,20 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
+#include <png.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
+
+#include <cstdio>  // before jpeglib.h, which uses FILE
+// clang-format off
+#include <jpeglib.h>
+#include <jerror.h>
+// clang-format on
 
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <csetjmp>
 #include <cstddef>
 #include <cmath>
 #include <cstdio>
@@ -25,6 +33,7 @@
 #include <vector>
 
 #include "core/file_util.h"
+#include "core/memory_budget.h"
 #include "io/png_text.h"
 
 namespace lc::io {
@@ -112,6 +121,14 @@ void checkSize(const std::string& path, int w, int h, uint64_t maxPixels) {
     throw ImageReadError(ImageReadError::Kind::TooLarge, path, reason,
                          "image " + quoteInput(path) + " is " + reason, w, h);
   }
+  // Counted against --max-memory before decoding, across every image of the run (textures,
+  // environment maps, compare's inputs): float texels and the decoder's buffer.
+  const uint64_t bytes = n * memory_cost::kTexel;
+  if (!processBudget().tryReserve(bytes)) {
+    std::string msg = processBudget().overBudget(
+        bytes, "the " + std::to_string(w) + "x" + std::to_string(h) + " pixels of " + quoteInput(path));
+    throw ImageReadError(ImageReadError::Kind::Memory, path, msg, msg, w, h);
+  }
 }
 
 Image readExr(const std::string& path, uint64_t maxPixels) {
@@ -165,179 +182,254 @@ std::vector<uint8_t> readAll(FILE* f) {
   return b;
 }
 
-// JPEG files are checked before stb_image 2.27 (Debian's libstb) sees them, for two bugs
-// the image fuzz target found (data/regressions/image/jpeg_*):
-//  - a Huffman table (DHT) whose code counts add up to more than 256 makes it write past
-//    stbi__huffman::size[257]; one with 256 codes of at most 9 bits makes the slow decode
-//    path index values[] with a negative symbol id;
-//  - a scan (SOS) that uses a Huffman table no DHT defined makes it decode with
-//    uninitialised memory (it mallocs its state without clearing it): reads far out of
-//    bounds.
-// The walk follows stb's own (stbi__decode_jpeg_header, stbi__decode_jpeg_image): fill
-// bytes, junk between segments before the frame header, 0 read past the end. Entropy-coded
-// data is skipped to the next FF xx that is not a stuffed 00, a fill FF or a restart
-// marker: stb either stops at that same marker or ends the image earlier, so every DHT and
-// SOS it acts on is one the walk checks. Returns the reason to refuse the file, or "".
-// Besides the walk, every FF C4 in the file is checked as a DHT (cheap, and independent of
-// the walk's reading of the structure).
-std::string jpegProblem(const std::vector<uint8_t>& b) {
-  auto tableProblem = [](const int* counts) -> const char* {
-    int n = 0, short9 = 0;
-    for (int i = 0; i < 16; ++i) {
-      n += counts[i];
-      if (i < 9) short9 += counts[i];
-    }
-    if (n > 256) return "corrupt JPEG (a Huffman table has more than 256 codes)";
-    if (n == 256 && short9 == 256) return "corrupt JPEG (a Huffman table has 256 codes of at most 9 bits)";
-    return nullptr;
-  };
-  for (size_t i = 0; i + 1 < b.size(); ++i) {
-    if (b[i] != 0xFF || b[i + 1] != 0xC4) continue;
-    size_t q = i + 2;
-    auto at = [&](size_t k) -> int { return k < b.size() ? b[k] : 0; };
-    long len = (at(q) << 8) + at(q + 1) - 2;
-    q += 2;
-    while (len > 0 && q < b.size()) {
-      if ((at(q) >> 4) > 1 || (at(q) & 15) > 3) break;
-      int counts[16], n = 0;
-      for (int k = 0; k < 16; ++k) n += counts[k] = at(q + 1 + size_t(k));
-      if (const char* why = tableProblem(counts)) return why;
-      q += 17 + size_t(n);
-      len -= 17 + n;
-    }
-  }
+const std::array<float, 256>& srgbTable() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) t[size_t(i)] = srgbToLinear(float(i) / 255.0f);
+    return t;
+  }();
+  return table;
+}
 
-  size_t p = 0;
-  auto eof = [&] { return p >= b.size(); };
-  auto get8 = [&]() -> int { return p < b.size() ? b[p++] : 0; };
-  auto get16 = [&] {
-    int hi = get8();
-    return (hi << 8) + get8();
+// libpng and libjpeg report errors through a callback that must not return: it longjmps back
+// to the setjmp of the function that called into the library. The functions holding a setjmp
+// (pngInfo, pngSetup, pngPixels, jpegHeader, jpegPixels) keep only plain data in their frames;
+// every C++ object (the pixel buffers, the Image) belongs to their callers, so a jump skips no
+// destructor. The library structs are freed by PngRead's / JpegRead's destructors on every path.
+
+// ---- PNG: libpng ----------------------------------------------------------------------------
+
+struct PngRead {
+  png_structp png = nullptr;
+  png_infop info = nullptr;
+  FILE* file = nullptr;
+  int passes = 1;          // 7 for an interlaced PNG
+  bool truncated = false;  // the read callback hit the end of the file
+  char message[256] = "";
+  ~PngRead() { png_destroy_read_struct(&png, info ? &info : nullptr, nullptr); }
+};
+
+void pngError(png_structp png, png_const_charp msg) {
+  auto* r = static_cast<PngRead*>(png_get_error_ptr(png));
+  std::snprintf(r->message, sizeof r->message, "%s", msg ? msg : "unknown error");
+  png_longjmp(png, 1);
+}
+void pngWarning(png_structp, png_const_charp) {}  // ancillary problems: libpng skips the chunk
+void pngReadData(png_structp png, png_bytep data, size_t n) {
+  auto* r = static_cast<PngRead*>(png_get_io_ptr(png));
+  if (std::fread(data, 1, n, r->file) != n) {
+    r->truncated = !std::ferror(r->file);
+    png_error(png, r->truncated ? "the file ends early" : "read error");
+  }
+}
+
+// Reads the chunks up to the image data (the size is then known: the caller checks it before
+// pngSetup, whose png_read_update_info allocates row buffers).
+bool pngInfo(PngRead& r) {
+  if (setjmp(png_jmpbuf(r.png))) return false;
+  // libpng's default caps each side at 10^6; the caller's pixel limit is the one to apply.
+  png_set_user_limits(r.png, PNG_UINT_31_MAX, PNG_UINT_31_MAX);
+  png_read_info(r.png, r.info);
+  return true;
+}
+
+// The transforms that give what stb_image gave when asked for 3 channels: palette -> RGB, grey
+// of 1/2/4 bits -> 8 bits (scaled to 0..255), grey -> RGB, alpha (and tRNS) dropped; 8 and 16
+// bits stay as they are (16-bit samples big-endian). No gamma or colour-space transform (stb
+// applied none).
+bool pngSetup(PngRead& r) {
+  if (setjmp(png_jmpbuf(r.png))) return false;
+  const int colorType = png_get_color_type(r.png, r.info), depth = png_get_bit_depth(r.png, r.info);
+  if (colorType == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(r.png);
+  if (colorType == PNG_COLOR_TYPE_GRAY && depth < 8) png_set_expand_gray_1_2_4_to_8(r.png);
+  if (colorType == PNG_COLOR_TYPE_GRAY || colorType == PNG_COLOR_TYPE_GRAY_ALPHA) png_set_gray_to_rgb(r.png);
+  png_set_strip_alpha(r.png);
+  r.passes = png_set_interlace_handling(r.png);
+  png_read_update_info(r.png, r.info);
+  return true;
+}
+
+// Row by row into the caller's buffer (no array of row pointers: as many as the rows); an
+// interlaced image passes over the rows once per pass.
+bool pngPixels(PngRead& r, uint8_t* data, size_t rowBytes, uint32_t height) {
+  if (setjmp(png_jmpbuf(r.png))) return false;
+  for (int pass = 0; pass < r.passes; ++pass)
+    for (uint32_t y = 0; y < height; ++y) png_read_row(r.png, data + y * rowBytes, nullptr);
+  png_read_end(r.png, nullptr);  // through IEND: the last CRC, and a file cut after the data
+  return true;
+}
+
+Image readPng(const std::string& path, FILE* f, bool srgb, uint64_t maxPixels) {
+  PngRead r;
+  r.file = f;
+  r.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &r, pngError, pngWarning);
+  if (r.png) r.info = png_create_info_struct(r.png);
+  if (!r.png || !r.info) throwDecode(path, "out of memory (libpng)");
+  png_set_read_fn(r.png, &r, pngReadData);
+#ifdef FUZZING_BUILD_MODE_UNSAFE_FOR_PRODUCTION
+  // Fuzz builds only (CMakeLists.txt): a mutated PNG would almost always stop at a checksum.
+  png_set_crc_action(r.png, PNG_CRC_QUIET_USE, PNG_CRC_QUIET_USE);
+  png_set_option(r.png, PNG_IGNORE_ADLER32, PNG_OPTION_ON);
+#endif
+  auto fail = [&]() {
+    // A size that IHDR gave is reported against the limit even when a later chunk is bad.
+    const uint32_t w = png_get_image_width(r.png, r.info), h = png_get_image_height(r.png, r.info);
+    if (w > 0 && h > 0) checkSize(path, int(w), int(h), maxPixels);
+    if (r.truncated) throwDecode(path, "truncated PNG: the file ends before the image data does");
+    throwDecode(path, std::string("corrupt PNG (") + r.message + ")");
   };
-  auto skip = [&](long n) { p = n > 0 ? std::min(b.size(), p + size_t(n)) : p; };
-  constexpr int kNone = 0xFF;
-  auto marker = [&]() -> int {  // stbi__get_marker
-    int x = get8();
-    if (x != 0xFF) return kNone;
-    while (x == 0xFF) x = get8();
-    return x;
-  };
-  bool dcDefined[4] = {false, false, false, false}, acDefined[4] = {false, false, false, false};
-  std::string problem;
-  // stbi__process_marker: false when stb fails (the image ends there).
-  auto processMarker = [&](int m) -> bool {
-    if (m == 0xDD) {  // DRI
-      if (get16() != 4) return false;
-      get16();
-      return true;
-    }
-    if (m == 0xDB) {  // DQT
-      long len = get16() - 2;
-      while (len > 0) {
-        int q = get8(), pq = q >> 4, t = q & 15;
-        if ((pq != 0 && pq != 1) || t > 3) return false;
-        skip(pq ? 128 : 64);
-        len -= pq ? 129 : 65;
+  if (!pngInfo(r)) fail();
+  const uint32_t w = png_get_image_width(r.png, r.info), h = png_get_image_height(r.png, r.info);
+  checkSize(path, int(w), int(h), maxPixels);  // libpng caps both at 2^31 - 1
+  if (!pngSetup(r)) fail();
+  const int depth = png_get_bit_depth(r.png, r.info);
+  const size_t rowBytes = png_get_rowbytes(r.png, r.info);
+  if (png_get_channels(r.png, r.info) != 3 || (depth != 8 && depth != 16) ||
+      rowBytes != size_t(w) * 3 * size_t(depth / 8))
+    throwDecode(path, "PNG layout not handled (" + std::to_string(png_get_channels(r.png, r.info)) +
+                          " channels of " + std::to_string(depth) + " bits after expansion)");
+  std::vector<uint8_t> data(rowBytes * h);
+  if (!pngPixels(r, data.data(), rowBytes, h)) fail();
+
+  Image img(static_cast<int>(w), static_cast<int>(h));
+  const auto& table = srgbTable();
+  for (size_t i = 0; i < img.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const size_t k = 3 * i + size_t(c);
+      if (depth == 8) {
+        img.pixels[i][c] = srgb ? table[data[k]] : float(data[k]) / 255.0f;
+      } else {
+        const float v = float(unsigned(data[2 * k]) << 8 | data[2 * k + 1]) / 65535.0f;
+        img.pixels[i][c] = srgb ? srgbToLinear(v) : v;
       }
-      return len == 0;
     }
-    if (m == 0xC4) {  // DHT
-      long len = get16() - 2;
-      while (len > 0) {
-        int q = get8(), tc = q >> 4, th = q & 15;
-        if (tc > 1 || th > 3) return false;
-        int counts[16], n = 0;
-        for (int k = 0; k < 16; ++k) n += counts[k] = get8();
-        if (const char* why = tableProblem(counts)) {
-          problem = why;
-          return false;
-        }
-        (tc == 0 ? dcDefined : acDefined)[th] = true;
-        skip(n);
-        len -= 17 + n;
-      }
-      return len == 0;
-    }
-    if ((m >= 0xE0 && m <= 0xEF) || m == 0xFE) {  // APPn, COM
-      int len = get16();
-      if (len < 2) return false;
-      skip(len - 2);
-      return true;
-    }
+  return img;
+}
+
+// ---- JPEG: libjpeg-turbo ----------------------------------------------------------------------
+
+struct JpegRead {
+  jpeg_decompress_struct cinfo{};
+  jpeg_error_mgr err{};
+  jpeg_progress_mgr progress{};
+  std::jmp_buf jump{};
+  bool truncated = false;  // libjpeg's source reached the end of the file
+  char message[JMSG_LENGTH_MAX] = "";
+  // Safe whether or not jpeg_create_decompress ran or finished: it frees what cinfo.mem holds.
+  ~JpegRead() { jpeg_destroy_decompress(&cinfo); }
+};
+
+// A progressive JPEG may hold any number of scans, and each one passes over the whole image:
+// a small file can keep the decoder busy for hours (djpeg -maxscans guards against the same).
+// Real encoders write about 10.
+constexpr int kMaxJpegScans = 1000;
+
+[[noreturn]] void jpegFail(j_common_ptr c) {
+  auto* r = static_cast<JpegRead*>(c->client_data);
+  (*c->err->format_message)(c, r->message);
+  std::longjmp(r->jump, 1);
+}
+// Warnings (msg_level -1) that mean the data is corrupt are errors: libjpeg would go on and
+// fill what it could not decode with grey. Those about metadata are ignored.
+void jpegMessage(j_common_ptr c, int level) {
+  if (level != -1) return;  // trace messages
+  const int code = c->err->msg_code;
+  if (code == JWRN_ADOBE_XFORM || code == JWRN_JFIF_MAJOR || code == JWRN_BOGUS_ICC) return;
+  static_cast<JpegRead*>(c->client_data)->truncated = code == JWRN_JPEG_EOF;
+  jpegFail(c);
+}
+void jpegProgress(j_common_ptr c) {
+  auto* d = reinterpret_cast<j_decompress_ptr>(c);
+  if (d->input_scan_number > kMaxJpegScans) {
+    auto* r = static_cast<JpegRead*>(c->client_data);
+    std::snprintf(r->message, sizeof r->message, "more than %d scans", kMaxJpegScans);
+    std::longjmp(r->jump, 1);
+  }
+}
+
+// Two steps, each returning false with r.message: the header (the size, checked by the caller
+// before it allocates), then the pixels into the caller's Image.
+struct JpegHeader {
+  uint32_t width = 0, height = 0;
+};
+bool jpegHeader(JpegRead& r, FILE* f, JpegHeader& h) {
+  if (setjmp(r.jump)) return false;
+  jpeg_create_decompress(&r.cinfo);
+  r.cinfo.progress = &r.progress;
+  jpeg_stdio_src(&r.cinfo, f);
+  jpeg_read_header(&r.cinfo, TRUE);
+  h.width = r.cinfo.image_width;
+  h.height = r.cinfo.image_height;
+  // CMYK and YCCK (Adobe) come out as CMYK and are converted as stb_image did; grey and
+  // YCbCr as RGB.
+  const bool cmyk = r.cinfo.jpeg_color_space == JCS_CMYK || r.cinfo.jpeg_color_space == JCS_YCCK;
+  r.cinfo.out_color_space = cmyk ? JCS_CMYK : JCS_RGB;
+  // libjpeg's defaults, the integer IDCT and "fancy" (triangle) chroma upsampling, are the
+  // closest to stb_image of the choices (measured on the repository's JPEGs: within 3 of 255).
+  r.cinfo.dct_method = JDCT_ISLOW;
+  r.cinfo.do_fancy_upsampling = TRUE;
+  return true;
+}
+
+// stb_image's CMYK -> RGB (stbi__blinn_8x8): channel * K / 255, rounded.
+inline uint8_t blinn8(unsigned x, unsigned y) {
+  unsigned t = x * y + 128;
+  return uint8_t((t + (t >> 8)) >> 8);
+}
+
+bool jpegPixels(JpegRead& r, uint8_t* row, Image& img, bool srgb) {
+  if (setjmp(r.jump)) return false;
+  jpeg_start_decompress(&r.cinfo);
+  const int n = r.cinfo.output_components;
+  if ((n != 3 && n != 4) || r.cinfo.output_width != uint32_t(img.width) ||
+      r.cinfo.output_height != uint32_t(img.height)) {
+    std::snprintf(r.message, sizeof r.message, "unexpected output layout (%d components)", n);
     return false;
-  };
+  }
+  const auto& table = srgbTable();
+  while (r.cinfo.output_scanline < r.cinfo.output_height) {
+    const size_t y = r.cinfo.output_scanline;
+    JSAMPROW rows[1] = {row};
+    if (jpeg_read_scanlines(&r.cinfo, rows, 1) != 1) {
+      std::snprintf(r.message, sizeof r.message, "no scanline decoded");
+      return false;
+    }
+    Color* out = &img.pixels[y * size_t(img.width)];
+    for (size_t x = 0; x < size_t(img.width); ++x) {
+      const uint8_t* p = row + x * size_t(n);
+      uint8_t rgb[3] = {p[0], p[1], p[2]};
+      if (n == 4)
+        for (int c = 0; c < 3; ++c) rgb[c] = blinn8(p[c], p[3]);
+      for (int c = 0; c < 3; ++c) out[x][c] = srgb ? table[rgb[c]] : float(rgb[c]) / 255.0f;
+    }
+  }
+  // No jpeg_finish_decompress: every row is decoded; what follows the last scan is not read.
+  return true;
+}
 
-  if (marker() != 0xD8) return "";  // not a JPEG to stb
-  int m = marker();
-  while (!(m == 0xC0 || m == 0xC1 || m == 0xC2)) {
-    if (!processMarker(m)) return problem;
-    m = marker();
-    while (m == kNone) {
-      if (eof()) return problem;
-      m = marker();
-    }
-  }
-  const bool progressive = m == 0xC2;
-  // Frame header (stbi__process_frame_header): the component ids.
-  int lf = get16();
-  get8();
-  get16();
-  get16();
-  int nComp = get8();
-  if (nComp != 1 && nComp != 3 && nComp != 4) return problem;
-  if (lf != 8 + 3 * nComp) return problem;
-  int ids[4];
-  for (int i = 0; i < nComp; ++i) {
-    ids[i] = get8();
-    get8();
-    get8();
-  }
-  m = marker();
-  while (m != 0xD9) {
-    if (m == 0xDA) {  // SOS (stbi__process_scan_header)
-      int ls = get16(), nScan = get8();
-      if (nScan < 1 || nScan > 4 || nScan > nComp || ls != 6 + 2 * nScan) return problem;
-      int hd[4], ha[4];
-      for (int i = 0; i < nScan; ++i) {
-        int id = get8(), q = get8(), which = 0;
-        while (which < nComp && ids[which] != id) ++which;
-        if (which == nComp) return problem;
-        hd[i] = q >> 4;
-        ha[i] = q & 15;
-        if (hd[i] > 3 || ha[i] > 3) return problem;
-      }
-      int specStart = get8(), specEnd = get8(), aa = get8(), succHigh = aa >> 4, succLow = aa & 15;
-      if (progressive) {
-        if (specStart > 63 || specEnd > 63 || specStart > specEnd || succHigh > 13 || succLow > 13) return problem;
-      } else if (specStart != 0 || succHigh != 0 || succLow != 0) {
-        return problem;
-      }
-      for (int i = 0; i < nScan; ++i) {
-        bool needDc = progressive ? specStart == 0 && succHigh == 0 : true;
-        bool needAc = progressive ? specStart != 0 : true;
-        if ((needDc && !dcDefined[hd[i]]) || (needAc && !acDefined[ha[i]]))
-          return "corrupt JPEG (a scan uses a Huffman table that is not defined)";
-      }
-      // Entropy-coded data: to the next FF xx that is a marker.
-      m = -1;
-      while (p < b.size() && m < 0) {
-        if (b[p++] != 0xFF) continue;
-        int x = get8();
-        while (x == 0xFF) x = get8();
-        if (x != 0 && !(x >= 0xD0 && x <= 0xD7)) m = x;
-      }
-      if (m < 0) return problem;  // end of file
-      continue;
-    }
-    if (m == 0xDC) {  // DNL
-      if (get16() != 4) return problem;
-      get16();
-    } else if (!processMarker(m)) {
-      return problem;
-    }
-    m = marker();
-  }
-  return problem;
+Image readJpeg(const std::string& path, FILE* f, bool srgb, uint64_t maxPixels) {
+  JpegRead r;
+  r.cinfo.err = jpeg_std_error(&r.err);
+  r.cinfo.client_data = &r;
+  r.err.error_exit = jpegFail;
+  r.err.emit_message = jpegMessage;
+  r.progress.progress_monitor = jpegProgress;
+  auto fail = [&]() {
+    if (r.truncated) throwDecode(path, "truncated JPEG: the file ends before the image data does");
+    // libjpeg's messages: "Corrupt JPEG data: ...", "Unsupported JPEG process: ...", ...
+    std::string msg = r.message;
+    const std::string corrupt = "Corrupt JPEG data: ";
+    if (msg.rfind(corrupt, 0) == 0) msg.erase(0, corrupt.size());
+    if (msg.rfind("Unsupported ", 0) == 0) throwDecode(path, "JPEG feature not supported (" + msg + ")");
+    throwDecode(path, "corrupt JPEG (" + msg + ")");
+  };
+  JpegHeader h;
+  if (!jpegHeader(r, f, h)) fail();
+  checkSize(path, int(h.width), int(h.height), maxPixels);  // JPEG caps both at 65535
+  Image img(static_cast<int>(h.width), static_cast<int>(h.height));
+  std::vector<uint8_t> row(size_t(h.width) * 4);
+  if (!jpegPixels(r, row.data(), img, srgb)) fail();
+  return img;
 }
 
 // stb_image 2.27 loops forever on a Radiance HDR whose run-length data has a zero count,
@@ -407,8 +499,9 @@ bool hdrDecodeTerminates(const std::vector<uint8_t>& b) {
   return true;
 }
 
-// Binary PNM with 16-bit samples (P5/P6, maxval > 255). stb_image 2.27 gets these wrong
-// twice: it converts them to the requested channel count as if they were 8-bit, returning a
+// Binary PNM (P5/P6): the header's numbers are read here first, for every such file, and
+// refused above 2^31-1 (stb_image's int overflows). With 16-bit samples (maxval > 255),
+// stb_image 2.27 goes wrong twice: it converts them to the requested channel count as if they were 8-bit, returning a
 // buffer half the size it should be (a heap overflow when read: found by the image fuzz
 // target, data/regressions/image/pnm16_channel_conversion.pgm), and it does not swap the
 // big-endian samples. They are decoded here instead: value / maxval. Returns false (and
@@ -432,6 +525,9 @@ bool readPnm16(const std::string& path, const std::vector<uint8_t>& b, bool srgb
       v = std::min<uint64_t>(v * 10 + uint64_t(b[p] - '0'), uint64_t(1) << 40);
       ++p;
     }
+    // stb_image parses the same numbers into an int, overflowing (UB; found by fuzzing).
+    if (v > uint64_t(std::numeric_limits<int>::max()))
+      throwDecode(path, "bad PNM header (a number larger than 2147483647)");
     return true;
   };
   uint64_t w = 0, h = 0, maxval = 0;
@@ -528,15 +624,6 @@ struct StbiFree {
 struct FileCloser {
   void operator()(FILE* f) const { std::fclose(f); }
 };
-
-const std::array<float, 256>& srgbTable() {
-  static const std::array<float, 256> table = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) t[size_t(i)] = srgbToLinear(float(i) / 255.0f);
-    return t;
-  }();
-  return table;
-}
 
 }  // namespace
 
@@ -644,38 +731,15 @@ Image readImage(const std::string& path, bool srgb, uint64_t maxPixels) {
   if (got >= 4 && std::memcmp(magic, "8BPS", 4) == 0) throwDecode(path, "PSD images are not supported");
   if (got >= 4 && magic[0] == 0x53 && magic[1] == 0x80 && magic[2] == 0xF6 && magic[3] == 0x34)
     throwDecode(path, "PIC images are not supported");
-  // stb takes FF (FF)* D8 as a JPEG start: any file that starts with FF is checked.
-  if (got >= 1 && magic[0] == 0xFF) {
-    std::string why = jpegProblem(readAll(f.get()));
-    if (!why.empty()) throwDecode(path, why);
-  }
+  // PNG and JPEG go to libpng and libjpeg-turbo. A file that starts with FF is a JPEG unless
+  // its second byte is a TGA colour-map type (0 or 1: a TGA whose ID field is 255 bytes long).
+  if (got == 4 && magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G')
+    return readPng(path, f.get(), srgb, maxPixels);
+  if (got >= 2 && magic[0] == 0xFF && magic[1] > 1) return readJpeg(path, f.get(), srgb, maxPixels);
 
   if (got >= 2 && magic[0] == 'P' && (magic[1] == '5' || magic[1] == '6')) {
     Image img;
     if (readPnm16(path, readAll(f.get()), srgb, maxPixels, img)) return img;
-  }
-
-  // A PNG's size comes from its IHDR, read here: stb refuses sizes over 2^24 with a reason
-  // that stbi_info loses ("unknown image type"), and the limit is the one to report.
-  if (got == 4 && magic[0] == 0x89 && magic[1] == 'P' && magic[2] == 'N' && magic[3] == 'G') {
-    unsigned char head[24];
-    if (std::fread(head, 1, sizeof head, f.get()) == sizeof head &&
-        std::memcmp(head + 12, "IHDR", 4) == 0) {
-      auto be32 = [&](int at) {
-        return uint32_t(head[at]) << 24 | uint32_t(head[at + 1]) << 16 | uint32_t(head[at + 2]) << 8 |
-               uint32_t(head[at + 3]);
-      };
-      uint32_t pw = be32(16), ph = be32(20);
-      // The PNG specification caps both at 2^31 - 1; larger is a corrupt header.
-      const uint32_t kMaxInt = uint32_t(std::numeric_limits<int>::max());
-      if (pw > kMaxInt || ph > kMaxInt) throwDecode(path, "corrupt PNG (bad IHDR size)");
-      checkSize(path, int(pw), int(ph), maxPixels);
-      // stb_image's own cap (STBI_MAX_DIMENSIONS, 2^24 per side by default).
-      if (pw > (1u << 24) || ph > (1u << 24))
-        throwDecode(path, std::to_string(pw) + "x" + std::to_string(ph) +
-                              " PNG is wider or taller than the decoder's 16777216 pixels");
-    }
-    std::rewind(f.get());
   }
 
   int w = 0, h = 0, comp = 0;
@@ -683,8 +747,8 @@ Image readImage(const std::string& path, bool srgb, uint64_t maxPixels) {
   // stbi_info reports a top-down BMP's height as negative (as stored); the decoder flips it.
   if (h < 0 && h != std::numeric_limits<int>::min()) h = -h;
   checkSize(path, w, h, maxPixels);
-  // PNG, JPEG, PNM and HDR are checked elsewhere (by stb itself or above); BMP and TGA here.
-  if (!(got >= 1 && (magic[0] == 0x89 || magic[0] == 0xFF || magic[0] == 'P' || magic[0] == '#'))) {
+  // PNM and HDR are checked elsewhere (by stb itself or above); BMP and TGA here.
+  if (!(got >= 1 && (magic[0] == 'P' || magic[0] == '#'))) {
     std::string why = bmpTgaTruncation(readAll(f.get()));
     if (!why.empty()) throwDecode(path, why);
   }

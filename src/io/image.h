@@ -59,20 +59,23 @@ inline void writeImage(const std::string& path, const Image& image, ToneMap tone
 // add the location that referred to the file.
 class ImageReadError : public Error {
  public:
-  enum class Kind { Open, Decode, TooLarge };
+  // Memory: the pixels would not fit in --max-memory (core/memory_budget.h); what() says so.
+  enum class Kind { Open, Decode, TooLarge, Memory };
   ImageReadError(Kind kind, const std::string& path, const std::string& reason,
                  const std::string& msg, int width = 0, int height = 0)
       : Error(msg), kind(kind), path(path), reason(reason), width(width), height(height) {}
   Kind kind;
   std::string path;
-  std::string reason;     // strerror / stbi_failure_reason / OpenEXR's message
+  std::string reason;     // strerror, or the decoder's message (libpng, libjpeg, stb, OpenEXR)
   int width, height;      // the image size, for Kind::TooLarge
 };
 
-// Reads .exr as linear floats, and 8-bit formats (.png .jpg .bmp .tga .ppm .hdr) via stb_image:
-// 8-bit values become value/255 (linearised when srgb = true); 16-bit PNG value/65535;
-// .hdr stays linear. Grey images expand to RGB, alpha is dropped. The size is checked
-// against maxPixels before the pixels are decoded. Throws ImageReadError:
+// Reads by content, not extension: EXR (OpenEXR) as linear floats, PNG with libpng, JPEG with
+// libjpeg-turbo, BMP, TGA, PNM and Radiance HDR with stb_image (docs/ERRORS.md, "Image
+// decoders"). 8-bit values become value/255 (linearised when srgb = true); 16-bit PNG and
+// PNM value/65535 (maxval); .hdr stays linear. Grey and palette images expand to RGB, alpha
+// is dropped, CMYK JPEG is converted as stb_image did. The size is checked against maxPixels
+// from the header, before the pixels are decoded. Throws ImageReadError:
 //   "cannot open 'path': No such file or directory"
 //   "cannot read image 'path': <decoder's reason>"
 //   "image 'path' is WxH = N pixels, more than the limit of M"

@@ -74,6 +74,7 @@ Environment Environment::build(const io::EnvironmentDesc& d, const Limits& limit
             throw Error(d.map->loc, fmt::format("environment map {} is {}x{} pixels, more than --max-texture-pixels ({})",
                                                 quoteInput(d.map->path), err.width, err.height,
                                                 limits.maxTexturePixels));
+          case io::ImageReadError::Kind::Memory: throw Error(d.map->loc, err.reason);
           case io::ImageReadError::Kind::Decode: break;
         }
         throw Error(d.map->loc, "cannot read environment map " + quoteInput(d.map->path) + ": " + err.reason);

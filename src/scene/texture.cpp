@@ -30,6 +30,8 @@ std::shared_ptr<const Texture> Texture::load(const std::string& path, bool srgb,
                     std::to_string(uint64_t(e.width) * uint64_t(e.height)) +
                     " pixels, more than --max-texture-pixels (" +
                     std::to_string(limits.maxTexturePixels) + ")");
+      case io::ImageReadError::Kind::Memory:
+        throw Error(e.reason);
       case io::ImageReadError::Kind::Decode:
         break;
     }
