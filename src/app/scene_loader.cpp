@@ -27,7 +27,10 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
     po.emissionDensity = o.emissionDensity;
     po.defaultAttenuation = o.defaultAttenuation;
     po.limits = o.limits;
+    ProgressBar bar("scene", o.quiet);
+    po.progress = [&](double f) { bar.update(f); };
     desc = io::parseRayFile(path, po);
+    bar.finish();
   }
   out.warnings = desc.warnings;
   out.loadSeconds = since(t0);

@@ -49,6 +49,9 @@ class RayLexer {
   Token next();
 
   const std::string& file() const { return file_; }
+  // How far the lexer has read, of how much text (the parser's progress).
+  size_t offset() const { return pos_; }
+  size_t size() const { return text_.size(); }
   SourceLoc loc(const Token& t) const { return SourceLoc{file_, t.line, t.column}; }
   SourceLoc loc(int line, int column) const { return SourceLoc{file_, line, column}; }
 

@@ -451,8 +451,12 @@ void Parser::header() {
 SceneDesc Parser::run() {
   header();
   scene_.materials.push_back(MaterialDesc{});  // index 0: the initial default (all 0, index 1)
+  Progress progress(opt_.progress, double(lex_.size()));
+  size_t reported = 0;
   for (;;) {
     const Token& t = lex_.peek();
+    progress.add(double(lex_.offset() - reported));
+    reported = lex_.offset();
     if (t.kind == TokenKind::End) break;
     if (t.isPunct(';')) {
       lex_.next();

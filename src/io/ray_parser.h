@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "core/progress.h"
 #include "core/limits.h"
 #include "io/scene_desc.h"
 
@@ -22,6 +23,8 @@ struct ParseOptions {
   // --default-attenuation A,B,C: the constant, linear and quadratic coefficients of every
   // point_light and spot_light that sets none of the three (unset: 0, 0, 1).
   std::optional<std::array<float, 3>> defaultAttenuation;
+  // Called with the share of the text read (core/progress.h): a 40 MB scene takes seconds.
+  ProgressFn progress = {};
 };
 
 // Parses a .ray file. Relative paths inside (textures, obj_mesh) resolve against its directory.

@@ -1561,3 +1561,24 @@ TEST(RayParserEnvironment, BadValuesAreErrorsAtTheirPlace) {
 
 }  // namespace
 }  // namespace lc::io
+
+namespace lc::io {
+namespace {
+
+// The parser reports how much of the text it has read: non-decreasing shares, ending at 1
+// (the CLI's "scene" progress bar for large files).
+TEST(RayParserProgress, SharesOfTheTextRiseToOne) {
+  std::string text = "SBT-raytracer 1.0\n";
+  for (int i = 0; i < 20000; ++i) text += "translate(" + std::to_string(i) + ",0,0, sphere {})\n";
+  std::vector<double> seen;
+  ParseOptions o;
+  o.progress = [&](double f) { seen.push_back(f); };
+  SceneDesc d = parseRayString(text, "big.ray", ".", o);
+  EXPECT_EQ(d.objects.size(), 20000u);
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.back(), 1.0);
+  for (size_t i = 1; i < seen.size(); ++i) EXPECT_GE(seen[i], seen[i - 1]);
+}
+
+}  // namespace
+}  // namespace lc::io
