@@ -52,7 +52,7 @@ const LightSet& lightsFor(size_t n, LightType t) {
 void TreeBuild(benchmark::State& state) {
   const LightSet& s = lightsFor(size_t(state.range(0)), LightType(state.range(1)));
   TreeBuildOptions o;
-  o.builder = state.range(2) ? TreeBuilder::Seed : TreeBuilder::Agglomerative;
+  o.builder = state.range(2) ? TreeBuilder::Course : TreeBuilder::Agglomerative;
   for (auto _ : state) benchmark::DoNotOptimize(buildLightForest(s, o));
   state.SetLabel(std::string(lightTypeName(LightType(state.range(1)))) + (state.range(2) ? " seed" : " walter"));
   state.counters["lights/s"] = benchmark::Counter(double(state.range(0)) * double(state.iterations()), benchmark::Counter::kIsRate);
@@ -69,7 +69,7 @@ void Evaluate(benchmark::State& state) {
   if (!forests.count(n)) forests[n] = buildLightForest(s);
   Method m = Method(state.range(1));
   std::unique_ptr<LightEvaluator> ev = m == Method::Brute     ? makeBruteForce(s)
-                                       : m == Method::Seed    ? makeSeedCuts(s, forests[n], CutOptions{0.5f, 1000})
+                                       : m == Method::Course    ? makeCourseCuts(s, forests[n], CutOptions{0.5f, 1000})
                                                               : makeLightcuts(s, forests[n], CutOptions{});
   Rng r(9, 9);
   std::vector<ShadingPoint> pts(256);
@@ -94,7 +94,7 @@ BENCHMARK(TreeBuild)
     ->UseRealTime();
 BENCHMARK(TreeBuild)->ArgsProduct({{100000}, {int(LightType::Oriented)}, {1}})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(Evaluate)
-    ->ArgsProduct({{1000, 10000, 100000}, {int(Method::Lightcuts), int(Method::Seed)}})
+    ->ArgsProduct({{1000, 10000, 100000}, {int(Method::Lightcuts), int(Method::Course)}})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(Evaluate)->ArgsProduct({{1000, 10000}, {int(Method::Brute)}})->Unit(benchmark::kMicrosecond);
 

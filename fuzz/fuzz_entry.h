@@ -112,7 +112,7 @@ inline void loadScene(const uint8_t* data, size_t size, const std::string& baseD
   lights::ObjectLightOptions lo;
   lo.maxLights = tinyLimits().maxLights;
   lo.kind = (size & 1) ? lights::ObjectLightKind::Omni : lights::ObjectLightKind::Oriented;
-  lo.placement = (size & 2) ? lights::Placement::Seed : lights::Placement::Stratified;
+  lo.placement = (size & 2) ? lights::Placement::Course : lights::Placement::Stratified;
   (void)lights::addObjectLights(*s, lo);
   if (desc.instantRadiosity) {
     const io::InstantRadiosityDesc& ir = *desc.instantRadiosity;

@@ -62,7 +62,7 @@ struct RenderArgs {
 
 // --error's defaults live with the cut options (lightcuts/evaluator.h).
 constexpr float kLightcutsDefaultError = lightcuts::CutOptions{}.errorRatio;
-constexpr float kSeedDefaultError = lightcuts::kSeedCutsDefaultError;
+constexpr float kCourseDefaultError = lightcuts::kCourseCutsDefaultError;
 
 // --reconstruct auto: reconstruction cuts (every 4 pixels) from 512 x 512 pixels up, a
 // full lightcut at every point below. A cell of 4 x 4 pixels covers four times the
@@ -182,11 +182,11 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
   }
   lightcuts::Method method = lightcuts::parseMethod(a.method);
   lightcuts::TreeBuildOptions tb;
-  tb.builder = a.tree.empty() ? (method == lightcuts::Method::Seed ? lightcuts::TreeBuilder::Seed
+  tb.builder = a.tree.empty() ? (method == lightcuts::Method::Course ? lightcuts::TreeBuilder::Course
                                                                     : lightcuts::TreeBuilder::Agglomerative)
                               : lightcuts::parseTreeBuilder(a.tree);
   tb.seed = a.seed;
-  float error = a.error >= 0 ? a.error : (method == lightcuts::Method::Seed ? kSeedDefaultError : kLightcutsDefaultError);
+  float error = a.error >= 0 ? a.error : (method == lightcuts::Method::Course ? kCourseDefaultError : kLightcutsDefaultError);
   if (!std::isfinite(error)) throw Error("--error must be a finite number >= 0");
   io::ToneMap tonemap = io::parseToneMap(a.tonemap);
   if (!std::isfinite(a.exposure)) throw Error("--exposure must be a finite number");
@@ -269,7 +269,7 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
     tb.progress = [&](double f) { bar.update(f); };
     forest = lightcuts::buildLightForest(scene.lights(), tb);
     bar.finish();
-    evaluator = method == lightcuts::Method::Seed         ? lightcuts::makeSeedCuts(scene.lights(), forest, co)
+    evaluator = method == lightcuts::Method::Course         ? lightcuts::makeCourseCuts(scene.lights(), forest, co)
                 : method == lightcuts::Method::Stochastic ? lightcuts::makeStochasticLightcuts(scene.lights(), forest, co)
                                                           : lightcuts::makeLightcuts(scene.lights(), forest, co);
   }
@@ -602,7 +602,7 @@ void addRenderCommand(CLI::App& app) {
                 fmt::format("Direct lighting: lightcuts (Walter et al. 2005), seed (the course project's cuts), "
                             "stochastic (stochastic lightcuts, Yuksel 2019: unbiased, noisy, no error bound; average "
                             "with --spp) or brute; default {}", d.method))
-      ->check(CLI::IsMember({"lightcuts", "seed", "stochastic", "brute"}))
+      ->check(CLI::IsMember({"lightcuts", "seed", "course", "stochastic", "brute"}))
       ->group(cuts);
   c->add_option("--stochastic-cut", a->stochasticCut,
                 fmt::format("--method stochastic: clusters per shading point, one light drawn in each; default {}",
@@ -611,13 +611,13 @@ void addRenderCommand(CLI::App& app) {
       ->group(cuts);
   c->add_option("--tree", a->tree,
                 fmt::format("Light tree: walter (agglomerative) or seed (k-d split); default {} for --method seed, "
-                            "else {}", lightcuts::treeBuilderName(lightcuts::TreeBuilder::Seed),
+                            "else {}", lightcuts::treeBuilderName(lightcuts::TreeBuilder::Course),
                             lightcuts::treeBuilderName(lightcuts::TreeBuilder::Agglomerative)))
-      ->check(CLI::IsMember({"walter", "agglomerative", "seed"}))
+      ->check(CLI::IsMember({"walter", "agglomerative", "seed", "course"}))
       ->group(cuts);
   c->add_option("--error", a->error,
                 fmt::format("Error threshold: relative bound for lightcuts (default {}); radius/distance for seed "
-                            "(default {})", kLightcutsDefaultError, kSeedDefaultError))
+                            "(default {})", kLightcutsDefaultError, kCourseDefaultError))
       ->check(CLI::Range(0.0, 1e6))
       ->group(cuts);
   c->add_option("--max-cut", a->maxCut, fmt::format("Most nodes in one cut; default {}", d.maxCut))

@@ -42,7 +42,7 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
   const char* kind = nameOf(o.objectLights.kind, {std::pair{"oriented", lights::ObjectLightKind::Oriented},
                                                   std::pair{"omni", lights::ObjectLightKind::Omni}});
   const char* placement = nameOf(o.objectLights.placement, {std::pair{"stratified", lights::Placement::Stratified},
-                                                            std::pair{"seed", lights::Placement::Seed}});
+                                                            std::pair{"seed", lights::Placement::Course}});
   const char* normalize = nameOf(vpl.normalize, {std::pair{"power", lights::VplNormalize::Power},
                                                  std::pair{"object", lights::VplNormalize::Object}});
   const std::string lightsGroup = "Lights & GI";
@@ -64,7 +64,7 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
      return true;
    }, fmt::format("Where object lights go: stratified (area-uniform low-discrepancy) or seed (the seed's pattern); "
                   "default {}", placement))
-      ->check(CLI::IsMember({"stratified", "seed"}))
+      ->check(CLI::IsMember({"stratified", "seed", "course"}))
       ->group(lightsGroup);
   c.add_option_function<float>("--emission-density", [&o](const float& v) { o.emissionDensity = v; },
                                fmt::format("Point lights per unit of world area for `emission = (r,g,b)` object "

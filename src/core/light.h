@@ -65,7 +65,7 @@ struct Attenuation {
 };
 
 // Spot falloff as a function of cos(angle to the axis); non-decreasing in cos, so
-// falloff(cos_upper_bound) bounds a cluster. Seed form: max(0,cos)^exponent, zero at or
+// falloff(cos_upper_bound) bounds a cluster. Course (seed) form: max(0,cos)^exponent, zero at or
 // beyond the cutoff angle. UW form: smoothstep over [cone - penumbra, cone].
 struct SpotFalloff {
   float exponent = 0;

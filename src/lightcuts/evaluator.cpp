@@ -12,7 +12,7 @@ namespace lc::lightcuts {
 Method parseMethod(const std::string& name) {
   if (name == "brute") return Method::Brute;
   if (name == "lightcuts") return Method::Lightcuts;
-  if (name == "seed") return Method::Seed;
+  if (name == "seed" || name == "course") return Method::Course;
   if (name == "stochastic") return Method::Stochastic;
   throw Error("unknown method '" + name + "' (use brute, lightcuts, seed or stochastic)");
 }
@@ -21,7 +21,7 @@ const char* methodName(Method m) {
   switch (m) {
     case Method::Brute: return "brute";
     case Method::Lightcuts: return "lightcuts";
-    case Method::Seed: return "seed";
+    case Method::Course: return "seed";
     case Method::Stochastic: return "stochastic";
   }
   return "?";
@@ -483,19 +483,19 @@ class Lightcuts final : public LightEvaluator {
   CutOptions opt_;
 };
 
-class SeedCuts final : public LightEvaluator {
+class CourseCuts final : public LightEvaluator {
  public:
-  SeedCuts(const LightSet& lights, const LightForest& forest, const CutOptions& o)
+  CourseCuts(const LightSet& lights, const LightForest& forest, const CutOptions& o)
       : lights_(lights), forest_(forest), opt_(o) {
     // Trees without the seed's traversal data (agglomerative ones) get it here, once.
     seed_.resize(forest.trees.size());
     owned_.reserve(forest.trees.size());
     for (size_t t = 0; t < forest.trees.size(); ++t) {
       const LightTree& tree = forest.trees[t];
-      if (tree.seed.size() == tree.nodes.size()) {
-        seed_[t] = tree.seed.data();
+      if (tree.course.size() == tree.nodes.size()) {
+        seed_[t] = tree.course.data();
       } else {
-        owned_.push_back(seedNodeData(lights, tree));
+        owned_.push_back(courseNodeData(lights, tree));
         seed_[t] = owned_.back().data();
       }
     }
@@ -515,7 +515,7 @@ class SeedCuts final : public LightEvaluator {
       const LightGroup& g = lights_.groups[tree.group];
       const LightNode& n = tree.nodes[ni];
       if (!n.isLeaf()) {
-        const SeedNodeData& sd = seed_[t][ni];
+        const CourseNodeData& sd = seed_[t][ni];
         float dist = tree.type == LightType::Directional ? 1.0f : length(sp.p - sd.position);
         if (sd.error > opt_.errorRatio * dist && cutSize + stack.size() + 2 <= uint32_t(opt_.maxCut)) {
           stack.emplace_back(t, n.left);
@@ -541,19 +541,19 @@ class SeedCuts final : public LightEvaluator {
     stats.recordCut(cutSize);
     return {total, cutSize};
   }
-  Method method() const override { return Method::Seed; }
+  Method method() const override { return Method::Course; }
 
  private:
   // The contribution of a node's light: the light itself at a leaf, the synthetic
   // centroid light otherwise (its visibility measured toward the node's representative
   // light). `blocked` is set when an inner node's light is non-zero but fully occluded.
-  Color nodeLight(const LightTree& tree, const SeedNodeData* seed, const LightGroup& g, uint32_t ni,
+  Color nodeLight(const LightTree& tree, const CourseNodeData* seed, const LightGroup& g, uint32_t ni,
                   const ShadingPoint& sp, Visibility& vis, EvalStats& stats, bool& blocked) const {
     const LightNode& n = tree.nodes[ni];
     blocked = false;
     ShadowResult found;
     if (n.isLeaf()) return shadowedUnit(lights_.lights[n.rep], g, sp, vis, stats, found) * n.intensity;
-    const SeedNodeData& sd = seed[ni];
+    const CourseNodeData& sd = seed[ni];
     Light syn;
     syn.type = tree.type;
     syn.group = tree.group;
@@ -579,8 +579,8 @@ class SeedCuts final : public LightEvaluator {
   const LightSet& lights_;
   const LightForest& forest_;
   CutOptions opt_;
-  std::vector<const SeedNodeData*> seed_;  // per tree: its own or owned_'s
-  std::vector<std::vector<SeedNodeData>> owned_;
+  std::vector<const CourseNodeData*> seed_;  // per tree: its own or owned_'s
+  std::vector<std::vector<CourseNodeData>> owned_;
 };
 
 }  // namespace
@@ -592,9 +592,9 @@ std::unique_ptr<LightEvaluator> makeLightcuts(const LightSet& lights, const Ligh
                                               const CutOptions& options) {
   return std::make_unique<Lightcuts>(lights, forest, options);
 }
-std::unique_ptr<LightEvaluator> makeSeedCuts(const LightSet& lights, const LightForest& forest,
+std::unique_ptr<LightEvaluator> makeCourseCuts(const LightSet& lights, const LightForest& forest,
                                              const CutOptions& options) {
-  return std::make_unique<SeedCuts>(lights, forest, options);
+  return std::make_unique<CourseCuts>(lights, forest, options);
 }
 
 }  // namespace lc::lightcuts

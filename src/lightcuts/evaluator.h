@@ -30,8 +30,10 @@
 namespace lc::lightcuts {
 
 // Stochastic: stochastic lightcuts (stochastic.cpp), unbiased and noisy.
-enum class Method { Brute, Lightcuts, Seed, Stochastic };
-Method parseMethod(const std::string& name);  // "brute" | "lightcuts" | "seed" | "stochastic"
+// Course: the course project's cuts this product grew from ("the seed", docs/SEED.md;
+// `--method seed` or `course`).
+enum class Method { Brute, Lightcuts, Course, Stochastic };
+Method parseMethod(const std::string& name);  // "brute" | "lightcuts" | "seed" (or "course") | "stochastic"
 const char* methodName(Method m);
 
 // When a cut is good enough.
@@ -53,7 +55,7 @@ const char* cutCriterionName(CutCriterion c);
 // relative bound, so its --error has its own default; the seed did not publish its value,
 // and 0.25 gives the default Cornell box about the cut the seed reported (257 vs 273.6
 // lights per pixel).
-constexpr float kSeedCutsDefaultError = 0.25f;
+constexpr float kCourseCutsDefaultError = 0.25f;
 
 struct CutOptions {
   float errorRatio = 0.02f;  // --error: relative error threshold
@@ -110,7 +112,7 @@ class LightEvaluator {
 std::unique_ptr<LightEvaluator> makeBruteForce(const LightSet& lights);
 std::unique_ptr<LightEvaluator> makeLightcuts(const LightSet& lights, const LightForest& forest,
                                               const CutOptions& options);
-std::unique_ptr<LightEvaluator> makeSeedCuts(const LightSet& lights, const LightForest& forest,
+std::unique_ptr<LightEvaluator> makeCourseCuts(const LightSet& lights, const LightForest& forest,
                                              const CutOptions& options);
 std::unique_ptr<LightEvaluator> makeStochasticLightcuts(const LightSet& lights, const LightForest& forest,
                                                         const CutOptions& options);

@@ -197,11 +197,11 @@ TEST(Lightcuts, RefinesTheLargestBoundFirst) {
   }
 }
 
-TEST(SeedCuts, ZeroThresholdReachesEveryLight) {
+TEST(CourseCuts, ZeroThresholdReachesEveryLight) {
   LightSet s = cloud(200, LightType::Omni, 5);
-  LightForest f = buildLightForest(s, TreeBuildOptions{TreeBuilder::Seed, 1});
+  LightForest f = buildLightForest(s, TreeBuildOptions{TreeBuilder::Course, 1});
   auto bf = makeBruteForce(s);
-  auto seed = makeSeedCuts(s, f, CutOptions{0.0f, 1 << 30});
+  auto seed = makeCourseCuts(s, f, CutOptions{0.0f, 1 << 30});
   Unoccluded vis;
   EvalStats st;
   ShadingPoint sp = point(Vec3(0.5f, 0, 0));
@@ -213,15 +213,15 @@ TEST(SeedCuts, ZeroThresholdReachesEveryLight) {
 
 // The seed's cuts over an agglomerative tree, which stores no seed data: the evaluator
 // computes it, and every cut and value equals the one over the data stored at build time.
-TEST(SeedCuts, OnDemandSeedDataCutsAsStored) {
+TEST(CourseCuts, OnDemandSeedDataCutsAsStored) {
   LightSet s = cloud(500, LightType::Oriented, 9);
   TreeBuildOptions eager;
-  eager.seedData = true;
+  eager.courseData = true;
   LightForest stored = buildLightForest(s, eager);
   LightForest lazy = buildLightForest(s);
-  ASSERT_TRUE(lazy.trees[0].seed.empty());
-  auto a = makeSeedCuts(s, stored, CutOptions{0.3f, 1000});
-  auto b = makeSeedCuts(s, lazy, CutOptions{0.3f, 1000});
+  ASSERT_TRUE(lazy.trees[0].course.empty());
+  auto a = makeCourseCuts(s, stored, CutOptions{0.3f, 1000});
+  auto b = makeCourseCuts(s, lazy, CutOptions{0.3f, 1000});
   HalfBlocked vis;
   for (float x : {0.5f, -2.0f, 3.0f}) {
     ShadingPoint sp = point(Vec3(x, 0.25f, 0));
@@ -233,7 +233,7 @@ TEST(SeedCuts, OnDemandSeedDataCutsAsStored) {
   }
 }
 
-TEST(SeedCuts, BlockedRepresentativeFallsBackToChildren) {
+TEST(CourseCuts, BlockedRepresentativeFallsBackToChildren) {
   LightSet s;
   s.groups.push_back(LightGroup{});
   for (float x : {-1.0f, 1.0f}) {
@@ -242,7 +242,7 @@ TEST(SeedCuts, BlockedRepresentativeFallsBackToChildren) {
     l.intensity = Color(1);
     s.lights.push_back(l);
   }
-  LightForest f = buildLightForest(s, TreeBuildOptions{TreeBuilder::Seed, 1});
+  LightForest f = buildLightForest(s, TreeBuildOptions{TreeBuilder::Course, 1});
   // The centroid light's visibility is taken toward the root's representative light:
   // block exactly that light; the other child is visible.
   float blockedX = s.lights[f.trees[0].nodes[0].rep].position.x;
@@ -251,7 +251,7 @@ TEST(SeedCuts, BlockedRepresentativeFallsBackToChildren) {
     Color operator()(const Vec3& wi, float) override { return wi.x * x > 0 ? Color(0) : Color(1); }
   } vis;
   vis.x = blockedX;
-  auto seed = makeSeedCuts(s, f, CutOptions{10.0f, 1000});
+  auto seed = makeCourseCuts(s, f, CutOptions{10.0f, 1000});
   EvalStats st;
   ShadingPoint sp = point(Vec3(0, 0, 0));
   sp.ks = Color(0);
@@ -268,7 +268,7 @@ TEST(SeedCuts, BlockedRepresentativeFallsBackToChildren) {
 
 TEST(Methods, ParseNames) {
   EXPECT_EQ(parseMethod("brute"), Method::Brute);
-  EXPECT_EQ(parseMethod("seed"), Method::Seed);
+  EXPECT_EQ(parseMethod("seed"), Method::Course);
   EXPECT_THROW(parseMethod("fast"), Error);
 }
 

@@ -16,7 +16,7 @@ namespace lc::lightcuts {
 size_t LightForest::memoryBytes() const {
   size_t b = 0;
   for (const LightTree& t : trees)
-    b += t.nodes.size() * sizeof(LightNode) + t.seed.size() * sizeof(SeedNodeData) +
+    b += t.nodes.size() * sizeof(LightNode) + t.course.size() * sizeof(CourseNodeData) +
          t.moments.size() * sizeof(NodeMoments) +
          t.preorder.size() * sizeof(uint32_t);
   return b;
@@ -30,12 +30,12 @@ size_t LightForest::nodeCount() const {
 
 TreeBuilder parseTreeBuilder(const std::string& name) {
   if (name == "walter" || name == "agglomerative") return TreeBuilder::Agglomerative;
-  if (name == "seed") return TreeBuilder::Seed;
+  if (name == "seed" || name == "course") return TreeBuilder::Course;
   throw Error("unknown light tree builder '" + name + "' (use walter or seed)");
 }
 
 const char* treeBuilderName(TreeBuilder b) {
-  return b == TreeBuilder::Seed ? "seed" : "walter";
+  return b == TreeBuilder::Course ? "seed" : "walter";
 }
 
 void coneUnion(const Vec3& a, float cosA, const Vec3& b, float cosB, Vec3& axis, float& cosOut) {
@@ -208,16 +208,16 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
   });
 }
 
-void computeSeedData(const LightSet& lights, LightTree& tree) {
+void computeCourseData(const LightSet& lights, LightTree& tree) {
   if (tree.moments.size() != tree.nodes.size() / 2) computeMoments(lights, tree);
-  tree.seed = seedNodeData(lights, tree);
+  tree.course = courseNodeData(lights, tree);
 }
 
-std::vector<SeedNodeData> seedNodeData(const LightSet& lights, const LightTree& tree) {
+std::vector<CourseNodeData> courseNodeData(const LightSet& lights, const LightTree& tree) {
   // Bottom-up, from the moments. The mean distance to the centroid is exact for leaves and
   // bounded above through the triangle inequality for inner nodes; the seed builder
   // overwrites it with exact values.
-  std::vector<SeedNodeData> sd(tree.nodes.size(), SeedNodeData{});
+  std::vector<CourseNodeData> sd(tree.nodes.size(), CourseNodeData{});
   std::vector<float> spread(tree.nodes.size(), 0.0f);
   auto chroma = [](const Color& c) {
     double s = double(c.x) + c.y + c.z;  // in double: the float sum may overflow
@@ -225,7 +225,7 @@ std::vector<SeedNodeData> seedNodeData(const LightSet& lights, const LightTree& 
   };
   for (size_t i = tree.nodes.size(); i-- > 0;) {
     const LightNode& n = tree.nodes[i];
-    SeedNodeData& d = sd[i];
+    CourseNodeData& d = sd[i];
     const NodeMoments mo = tree.momentsOf(lights, i);
     d.position = mo.centroid;
     if (n.isLeaf()) {
@@ -233,8 +233,8 @@ std::vector<SeedNodeData> seedNodeData(const LightSet& lights, const LightTree& 
       d.error = 0;
       continue;
     }
-    const SeedNodeData& da = sd[n.left];
-    const SeedNodeData& db = sd[n.left + 1];
+    const CourseNodeData& da = sd[n.left];
+    const CourseNodeData& db = sd[n.left + 1];
     d.direction = length2(mo.meanAxis) > 0 ? normalize(mo.meanAxis) : da.direction;
     // Relative weights (in double: luminances near FLT_MAX would overflow their sum).
     double la = lum(tree.nodes[n.left].intensity), lb = lum(tree.nodes[n.left + 1].intensity);
@@ -340,8 +340,8 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
     const std::vector<uint32_t>& idx = *work[i].second;
     uint64_t seed = options.seed * 0x9E3779B97F4A7C15ull + i;
     LightTree t;
-    if (options.builder == TreeBuilder::Seed) {
-      t = buildSeedTree(lights, idx, k.type, seed);
+    if (options.builder == TreeBuilder::Course) {
+      t = buildCourseTree(lights, idx, k.type, seed);
       progress.add(double(idx.size()));
     } else {
       // c weights the normal cone for lights whose emission depends on direction.
@@ -356,7 +356,7 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
       }
       t = buildAgglomerativeTree(lights, idx, k.type, c, seed, std::max<size_t>(options.exactLimit, 2), &progress);
       // The builder fills the preorder and the moments.
-      if (options.seedData) computeSeedData(lights, t);
+      if (options.courseData) computeCourseData(lights, t);
     }
     if (t.preorder.size() != t.nodes.size()) computePreorder(t);
     if (k.type == LightType::Directional) computeDirectionCones(lights, t);

@@ -9,7 +9,7 @@
 //   Agglomerative (Walter et al. 2005, built the fast way of Walter et al. 2008): greedily
 //     merge the pair whose union minimises I * (alpha^2 + c^2 (1 - cos beta)^2), found by
 //     nearest-neighbour search in a k-d tree over clusters and a heap of best pairs.
-//   Seed (the course project's k-d split): recursive split over x, y, z at the position that
+//   Course (the course project's k-d split): recursive split over x, y, z at the position that
 //     balances the halves and falls at the largest gap in position and colour.
 // One tree per (light type, light group): clusters never mix attenuation or falloff.
 #pragma once
@@ -43,7 +43,7 @@ static_assert(sizeof(LightNode) == 64, "LightNode should fill one cache line");
 
 // Per-node data of the seed's traversal: a synthetic light at the intensity-weighted
 // centroid, and the node's error radius.
-struct SeedNodeData {
+struct CourseNodeData {
   Vec3 position;   // weighted centroid (directional: weighted mean direction)
   Vec3 direction;  // weighted mean normal/axis, unit
   float error;     // weighted mean distance to the centroid, scaled by the colour spread
@@ -61,8 +61,8 @@ struct LightTree {
   uint16_t group = 0;
   std::vector<LightNode> nodes;  // nodes[0] is the root
   // Parallel to nodes when filled: the seed builder fills it; agglomerative trees leave it
-  // empty (unless TreeBuildOptions::seedData) and makeSeedCuts computes it on demand.
-  std::vector<SeedNodeData> seed;
+  // empty (unless TreeBuildOptions::courseData) and makeCourseCuts computes it on demand.
+  std::vector<CourseNodeData> course;
   // Per inner node, at (left - 1) / 2: sibling pairs sit at nodes 1-2, 3-4, ..., so that is
   // each inner node's own slot (n - 1 of them). A leaf's moments are its light's
   // (momentsOf); storing them would repeat the light (24 bytes per light).
@@ -83,7 +83,8 @@ struct LightTree {
   uint32_t lightCount(uint32_t i) const { return nodes[i].lights; }
 };
 
-enum class TreeBuilder { Agglomerative, Seed };
+// Course: the course project's k-d split (`--tree seed` or `course`).
+enum class TreeBuilder { Agglomerative, Course };
 
 struct TreeBuildOptions {
   TreeBuilder builder = TreeBuilder::Agglomerative;
@@ -96,8 +97,8 @@ struct TreeBuildOptions {
   float sceneDiagonal = 0;
   ProgressFn progress = {};  // called with the share of lights clustered (core/progress.h)
   // Agglomerative trees: fill LightTree::seed as well (56 bytes per light that only
-  // --method seed reads; makeSeedCuts computes the same data when it is missing).
-  bool seedData = false;
+  // --method seed reads; makeCourseCuts computes the same data when it is missing).
+  bool courseData = false;
 };
 
 struct LightForest {
@@ -133,7 +134,7 @@ inline float clusterMetric(float intensity, const Vec3& lo, const Vec3& hi, floa
 LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint32_t>& indices,
                                  LightType type, float coneWeight, uint64_t seed,
                                  size_t exactLimit = 8192, Progress* progress = nullptr);
-LightTree buildSeedTree(const LightSet& lights, const std::vector<uint32_t>& indices, LightType type,
+LightTree buildCourseTree(const LightSet& lights, const std::vector<uint32_t>& indices, LightType type,
                         uint64_t seed);
 
 // Fills LightTree::preorder (buildLightForest calls it).
@@ -149,8 +150,8 @@ void computeMoments(const LightSet& lights, LightTree& tree);
 
 // Fills LightTree::seed from the finished nodes and their moments (centroids, mean
 // directions, errors).
-void computeSeedData(const LightSet& lights, LightTree& tree);
+void computeCourseData(const LightSet& lights, LightTree& tree);
 // The same data, for a tree that has its moments, without touching the tree.
-std::vector<SeedNodeData> seedNodeData(const LightSet& lights, const LightTree& tree);
+std::vector<CourseNodeData> courseNodeData(const LightSet& lights, const LightTree& tree);
 
 }  // namespace lc::lightcuts

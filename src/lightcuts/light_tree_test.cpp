@@ -82,8 +82,8 @@ TEST_P(TreeBuild, IsAValidClusterHierarchy) {
     ASSERT_EQ(f.trees.size(), 1u);
     checkTree(set, f.trees[0]);
     ASSERT_EQ(f.trees[0].moments.size(), f.trees[0].nodes.size() / 2);  // inner nodes only
-    // Only the seed builder stores the seed's traversal data; others leave it to makeSeedCuts.
-    ASSERT_EQ(f.trees[0].seed.size(), builder == TreeBuilder::Seed ? f.trees[0].nodes.size() : 0u);
+    // Only the seed builder stores the seed's traversal data; others leave it to makeCourseCuts.
+    ASSERT_EQ(f.trees[0].course.size(), builder == TreeBuilder::Course ? f.trees[0].nodes.size() : 0u);
   }
 }
 
@@ -93,18 +93,18 @@ TEST(TreeBuild, SeedDataOnDemandEqualsEager) {
   for (LightType type : {LightType::Omni, LightType::Oriented, LightType::Directional}) {
     LightSet set = randomLights(3000, type, 21, true);
     TreeBuildOptions eager{TreeBuilder::Agglomerative, 5};
-    eager.seedData = true;
+    eager.courseData = true;
     LightForest a = buildLightForest(set, eager);
     LightForest b = buildLightForest(set, TreeBuildOptions{TreeBuilder::Agglomerative, 5});
-    ASSERT_EQ(a.trees[0].seed.size(), a.trees[0].nodes.size());
-    ASSERT_TRUE(b.trees[0].seed.empty());
+    ASSERT_EQ(a.trees[0].course.size(), a.trees[0].nodes.size());
+    ASSERT_TRUE(b.trees[0].course.empty());
     EXPECT_LT(b.memoryBytes(), a.memoryBytes());
-    std::vector<SeedNodeData> lazy = seedNodeData(set, b.trees[0]);
-    ASSERT_EQ(lazy.size(), a.trees[0].seed.size());
+    std::vector<CourseNodeData> lazy = courseNodeData(set, b.trees[0]);
+    ASSERT_EQ(lazy.size(), a.trees[0].course.size());
     for (size_t i = 0; i < lazy.size(); ++i) {
-      ASSERT_EQ(lazy[i].position, a.trees[0].seed[i].position) << i;
-      ASSERT_EQ(lazy[i].direction, a.trees[0].seed[i].direction) << i;
-      ASSERT_EQ(lazy[i].error, a.trees[0].seed[i].error) << i;
+      ASSERT_EQ(lazy[i].position, a.trees[0].course[i].position) << i;
+      ASSERT_EQ(lazy[i].direction, a.trees[0].course[i].direction) << i;
+      ASSERT_EQ(lazy[i].error, a.trees[0].course[i].error) << i;
     }
   }
 }
@@ -123,7 +123,7 @@ TEST_P(TreeBuild, IsDeterministic) {
 
 INSTANTIATE_TEST_SUITE_P(
     All, TreeBuild,
-    ::testing::Combine(::testing::Values(TreeBuilder::Agglomerative, TreeBuilder::Seed),
+    ::testing::Combine(::testing::Values(TreeBuilder::Agglomerative, TreeBuilder::Course),
                        ::testing::Values(LightType::Omni, LightType::Oriented, LightType::Directional)),
     [](const auto& info) {
       return std::string(treeBuilderName(std::get<0>(info.param))) + "_" +
@@ -285,12 +285,12 @@ TEST(SeedBuild, SplitsAtTheLargestGap) {
     l.intensity = Color(1);
     set.lights.push_back(l);
   }
-  LightForest f = buildLightForest(set, TreeBuildOptions{TreeBuilder::Seed, 1});
+  LightForest f = buildLightForest(set, TreeBuildOptions{TreeBuilder::Course, 1});
   const LightTree& t = f.trees[0];
   uint32_t a = leafCount(t, t.nodes[0].left), b = leafCount(t, t.nodes[0].left + 1);
   EXPECT_EQ(std::min(a, b), 5u);
   // The seed error of a node of coincident equal lights is zero; of spread lights positive.
-  EXPECT_GT(t.seed[0].error, 0.0f);
+  EXPECT_GT(t.course[0].error, 0.0f);
 }
 
 TEST(SeedBuild, ErrorIsWeightedMeanDistanceToCentroid) {
@@ -302,9 +302,9 @@ TEST(SeedBuild, ErrorIsWeightedMeanDistanceToCentroid) {
     l.intensity = Color(1);
     set.lights.push_back(l);
   }
-  LightForest f = buildLightForest(set, TreeBuildOptions{TreeBuilder::Seed, 1});
-  EXPECT_FLOAT_EQ(f.trees[0].seed[0].error, 1.0f);  // same colour: no spread factor
-  EXPECT_EQ(f.trees[0].seed[0].position, Vec3(1, 0, 0));
+  LightForest f = buildLightForest(set, TreeBuildOptions{TreeBuilder::Course, 1});
+  EXPECT_FLOAT_EQ(f.trees[0].course[0].error, 1.0f);  // same colour: no spread factor
+  EXPECT_EQ(f.trees[0].course[0].position, Vec3(1, 0, 0));
 }
 
 // Issue 23: lights of huge but finite power (2e38: the sums overflow a float) used to make the
@@ -322,7 +322,7 @@ TEST(TreeBuild, HugeIntensitiesBuildQuicklyAndStayFinite) {
       std::future<LightForest> result = done->get_future();
       TreeBuildOptions o;
       o.exactLimit = exactLimit == 0 ? 8192 : exactLimit;
-      if (exactLimit == 0) o.builder = TreeBuilder::Seed;  // the other builder too
+      if (exactLimit == 0) o.builder = TreeBuilder::Course;  // the other builder too
       std::thread([done, set, o] { done->set_value(buildLightForest(set, o)); }).detach();
       if (result.wait_for(std::chrono::seconds(1)) != std::future_status::ready) {
         std::fprintf(stderr, "the tree build over lights of 2e38 did not finish within a second\n");

@@ -95,7 +95,7 @@ ObjectLightKind parseObjectLightKind(const std::string& s) {
 
 Placement parsePlacement(const std::string& s) {
   if (s == "stratified") return Placement::Stratified;
-  if (s == "seed") return Placement::Seed;
+  if (s == "seed" || s == "course") return Placement::Course;
   throw Error("unknown object light placement '" + s + "' (use stratified or seed)");
 }
 
@@ -184,7 +184,7 @@ void squareToDisk(double u, double v, double& x, double& y) {
 
 // The seed's pattern (see the top of the file): calls emit(b) for the first n points.
 template <class F>
-void seedPattern(uint64_t n, F&& emit) {
+void coursePattern(uint64_t n, F&& emit) {
   if (n == 0) return;
   const double c = 1.0 / 3;
   double b[3] = {c, c, c};
@@ -550,8 +550,8 @@ void fillMesh(const scene::Scene& scene, const Emitter& e, const ObjectLightOpti
                                       m.uvs[size_t(tri[2])] * float(b[2]);
         w.put(k++, p, normal, uv);
       };
-      if (o.placement == Placement::Seed) {
-        seedPattern(n, emit);
+      if (o.placement == Placement::Course) {
+        coursePattern(n, emit);
       } else {
         for (uint64_t i = 0; i < n; ++i) {
           double x, y, b[3];

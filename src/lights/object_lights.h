@@ -18,7 +18,7 @@ enum class ObjectLightKind {
 };
 enum class Placement {
   Stratified,  // area-uniform low-discrepancy samples over each triangle (default)
-  Seed,        // the seed's pattern: centroid, then along centroid-vertex lines, then between
+  Course,      // the course project's (the seed's) pattern: centroid, then along centroid-vertex lines, then between
 };
 
 ObjectLightKind parseObjectLightKind(const std::string& s);

@@ -78,7 +78,7 @@ std::string errorOf(const std::function<void()>& f) {
 TEST(ObjectLights, ParseKindAndPlacement) {
   EXPECT_EQ(parseObjectLightKind("omni"), ObjectLightKind::Omni);
   EXPECT_EQ(parseObjectLightKind("oriented"), ObjectLightKind::Oriented);
-  EXPECT_EQ(parsePlacement("seed"), Placement::Seed);
+  EXPECT_EQ(parsePlacement("seed"), Placement::Course);
   EXPECT_EQ(parsePlacement("stratified"), Placement::Stratified);
   EXPECT_THROW(parseObjectLightKind("spot"), Error);
   EXPECT_THROW(parsePlacement("random"), Error);
@@ -394,7 +394,7 @@ TEST(ObjectLights, TextureColoursAtKnownBarycentricPoints) {
            "(1.0833333333, 0.0833333333), (0.0833333333, 1.0833333333)); faces = ((0, 1, 2)); }\n";
   };
   ObjectLightOptions seed;
-  seed.placement = Placement::Seed;
+  seed.placement = Placement::Course;
   for (const std::string& colourWord : {std::string("map(\"") + tex + "\")", std::string("texture")}) {
     Built b = buildDesc(io::parseRayString("SBT-raytracer 1.0\n" + scene(2, colourWord), "t.ray", dir.path()), seed);
     const auto& ls = b.lights();
@@ -475,29 +475,29 @@ TEST(ObjectLights, SeedPatternForSmallBudgets) {
   const Vec3 c(1, 1, 0);
   auto spoke = [&](int j, double t) { return c + (v[j] - c) * float(t); };
 
-  auto p1 = trianglePoints(1, Placement::Seed);
+  auto p1 = trianglePoints(1, Placement::Course);
   ASSERT_EQ(p1.size(), 1u);
   expectPoint(p1[0], c);
 
   // n = 4: the centroid and the midpoints of the centroid-vertex lines.
-  auto p4 = trianglePoints(4, Placement::Seed);
+  auto p4 = trianglePoints(4, Placement::Course);
   ASSERT_EQ(p4.size(), 4u);
   expectPoint(p4[0], c);
   for (int j = 0; j < 3; ++j) expectPoint(p4[size_t(j + 1)], spoke(j, 0.5));
 
   // n = 2, 3: the spokes in vertex order, stopping mid-round.
-  auto p2 = trianglePoints(2, Placement::Seed);
+  auto p2 = trianglePoints(2, Placement::Course);
   ASSERT_EQ(p2.size(), 2u);
   expectPoint(p2[1], spoke(0, 0.5));
 
   // n = 7: then the midpoints between those lights, edges (0,1), (1,2), (2,0).
-  auto p7 = trianglePoints(7, Placement::Seed);
+  auto p7 = trianglePoints(7, Placement::Course);
   ASSERT_EQ(p7.size(), 7u);
   for (int e = 0; e < 3; ++e) expectPoint(p7[size_t(4 + e)], (spoke(e, 0.5) + spoke((e + 1) % 3, 0.5)) * 0.5f);
 
   // n = 13: k = round(sqrt(12/3)) = 2 levels at 1/3 and 2/3, then the outer level's
   // edge midpoints before the inner one's.
-  auto p13 = trianglePoints(13, Placement::Seed);
+  auto p13 = trianglePoints(13, Placement::Course);
   ASSERT_EQ(p13.size(), 13u);
   for (int l = 1; l <= 2; ++l)
     for (int j = 0; j < 3; ++j) expectPoint(p13[size_t(1 + 3 * (l - 1) + j)], spoke(j, l / 3.0));
@@ -507,7 +507,7 @@ TEST(ObjectLights, SeedPatternForSmallBudgets) {
   }
 
   // Large budgets: all distinct, all inside.
-  auto big = trianglePoints(500, Placement::Seed);
+  auto big = trianglePoints(500, Placement::Course);
   ASSERT_EQ(big.size(), 500u);
   std::set<std::tuple<float, float>> unique;
   for (const Vec3& p : big) {

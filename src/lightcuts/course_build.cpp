@@ -26,7 +26,7 @@ Color chromaticity(const Color& c) {
   return s > 0 ? Color(float(c.x / s), float(c.y / s), float(c.z / s)) : Color(1.0f / 3);
 }
 
-struct SeedBuilder {
+struct CourseBuilder {
   const LightSet& lights;
   std::vector<uint32_t> idx;    // light indices, reordered in place by the splits
   // Fixed slots, so the tree does not depend on thread timing: the leaf at position i is
@@ -143,24 +143,24 @@ struct SeedBuilder {
 
 }  // namespace
 
-LightTree buildSeedTree(const LightSet& lights, const std::vector<uint32_t>& indices, LightType type,
+LightTree buildCourseTree(const LightSet& lights, const std::vector<uint32_t>& indices, LightType type,
                         uint64_t seed) {
   LightTree tree;
   tree.type = type;
   if (indices.empty()) return tree;
-  SeedBuilder sb{lights, indices, {}, {}, seed};
+  CourseBuilder sb{lights, indices, {}, {}, seed};
   sb.clusters.resize(2 * indices.size() - 1);
   sb.exactError.resize(2 * indices.size() - 1);
   int32_t root = sb.build(0, indices.size());
   detail::layoutTree(sb.clusters, root, tree);
-  computeSeedData(lights, tree);
+  computeCourseData(lights, tree);
   // Replace the bottom-up error bounds with the exact errors: walk clusters and nodes in
   // the same order as the layout.
   std::vector<std::pair<int32_t, uint32_t>> stack{{root, 0u}};
   while (!stack.empty()) {
     auto [ci, ni] = stack.back();
     stack.pop_back();
-    tree.seed[ni].error = sb.exactError[size_t(ci)];
+    tree.course[ni].error = sb.exactError[size_t(ci)];
     const Cluster& c = sb.clusters[size_t(ci)];
     if (c.left >= 0) {
       stack.emplace_back(c.left, tree.nodes[ni].left);
