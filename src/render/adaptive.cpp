@@ -19,9 +19,10 @@ bool disagree(const CentreSample& a, const CentreSample& b, const RenderOptions&
   if (a.shape == -2 || b.shape == -2) return false;  // outside the image
   if (a.shape != b.shape) return true;
   if (a.shape >= 0 && dot(a.n, b.n) < o.aaNormalCos) return true;
-  if (a.known && b.known) {
-    float hi = std::max({a.luminance, b.luminance, o.aaContrastFloor});
-    if (std::fabs(a.luminance - b.luminance) > o.aaContrast * hi) return true;
+  if (a.known && b.known) {  // as displayed: white is white however bright
+    const float la = std::min(a.luminance, 1.0f), lb = std::min(b.luminance, 1.0f);
+    const float hi = std::max({la, lb, o.aaContrastFloor});
+    if (std::fabs(la - lb) > o.aaContrast * hi) return true;
   }
   return false;
 }

@@ -37,7 +37,10 @@ TEST(AdaptiveFlags, ShapeNormalAndContrastEachFlagBothSides) {
   EXPECT_TRUE(disagree(hitOn(1, z, 0.5f), CentreSample{}, o));       // the background
   EXPECT_TRUE(disagree(hitOn(1, z, 0.5f), hitOn(1, normalize(Vec3(0, 1, 1)), 0.5f), o));  // 45 degrees
   EXPECT_FALSE(disagree(hitOn(1, z, 0.5f), hitOn(1, normalize(Vec3(0, 0.2f, 1)), 0.5f), o));  // 11 degrees
-  EXPECT_TRUE(disagree(hitOn(1, z, 0.5f), hitOn(1, z, 0.4f), o));  // 20% contrast: a shadow edge
+  EXPECT_TRUE(disagree(hitOn(1, z, 0.5f), hitOn(1, z, 0.3f), o));   // 40% contrast: a shadow edge
+  EXPECT_FALSE(disagree(hitOn(1, z, 0.5f), hitOn(1, z, 0.4f), o));  // 20%: below aaContrast (25%)
+  EXPECT_TRUE(disagree(hitOn(1, z, 2.0f), hitOn(1, z, 0.7f), o));   // compared as displayed: 1 vs 0.7
+  EXPECT_FALSE(disagree(hitOn(1, z, 5.0f), hitOn(1, z, 3.0f), o));  // both white on screen
   EXPECT_FALSE(disagree(hitOn(1, z, 0.001f), hitOn(1, z, 0.002f), o));  // below the floor
   CentreSample unknown = hitOn(1, z, 0.0f);
   unknown.known = false;  // across a tile border: luminance not compared

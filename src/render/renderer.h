@@ -49,7 +49,7 @@ struct RenderOptions {
   // the same surface (else a full lightcut). Measured on the demo (docs/LIGHTCUTS.md).
   AntiAliasing aa = AntiAliasing::Adaptive;
   int aaSamples = 8;             // g^2 - 1 for odd g: 8 (3 x 3), 24 (5 x 5) or 48 (7 x 7)
-  float aaContrast = 0.1f;       // relative luminance contrast that flags a pixel
+  float aaContrast = 0.25f;      // relative luminance contrast that flags a pixel (docs/LIGHTCUTS.md)
   float aaContrastFloor = 0.02f; // luminance below which differences do not count relative
   float aaNormalCos = 0.9f;      // cos of the normal difference that flags (~25 degrees)
   int threads = 0;    // 0 = all cores
