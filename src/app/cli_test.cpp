@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -28,6 +29,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/math.h"
+#include "io/image.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -686,7 +689,9 @@ TEST(CliRender, SeedDrivesTheVpls) {
   writeText(dir.file("s.ray"), kHeader + "instant_radiosity { vpls = 20; }\n" + body);
   writeText(dir.file("s7.ray"), kHeader + "instant_radiosity { vpls = 20; seed = 7; }\n" + body);
   auto image = [&](const std::string& scene, std::vector<std::string> extra) {
-    std::vector<std::string> args = {"render", scene, "-o", "out.ppm", "-q", "--width", "32", "--method", "brute"};
+    // (--aa off: antialiasing's jitter follows --seed too, not the scene's VPL seed)
+    std::vector<std::string> args = {"render", scene, "-o", "out.ppm", "-q", "--width", "32", "--method", "brute",
+                                     "--aa", "off"};
     args.insert(args.end(), extra.begin(), extra.end());
     CliResult r = run(args, dir.path());
     EXPECT_EQ(r.status, 0) << r.err;
@@ -700,7 +705,7 @@ TEST(CliRender, SeedDrivesTheVpls) {
   EXPECT_EQ(noSeed, one);  // the default seed is 1
   EXPECT_EQ(image("s7.ray", {}), seven);
   EXPECT_EQ(image("s7.ray", {"--seed", "1"}), one);
-  // Without VPLs the seed changes nothing under brute force.
+  // Without VPLs (and antialiasing's jitter) the seed changes nothing under brute force.
   EXPECT_EQ(image("s.ray", {"--gi", "off", "--seed", "1"}), image("s.ray", {"--gi", "off", "--seed", "7"}));
 }
 
@@ -1366,3 +1371,87 @@ TEST(CliWarnings, CompareOf8BitImagesSaysTheyAreDisplayEncoded) {
 }
 
 }  // namespace
+
+// --aov: extra layers of the EXR beside R, G, B, read back with OpenEXR (io::readExrChannel)
+// and checked in closed form on a plane seen head on (albedo = its kd, normal = +z, depth =
+// the distance along each pixel's ray); other formats refuse it before rendering.
+TEST(CliOutput, AovLayersInTheExr) {
+  TempDir dir;
+  writeText(dir.file("plane.ray"), kHeader +
+                                       "camera { position = (0,0,5); viewdir = (0,0,-1); updir = (0,1,0); fov = 60; }\n"
+                                       "point_light { position = (0,0,3); colour = (1,1,1); }\n"
+                                       "scale(10, square { material = { diffuse = (0.5,0.6,0.7); }; })\n");
+  const int W = 12, H = 10;
+  CliResult r = run({"render", "plane.ray", "-o", "out.exr", "--width", std::to_string(W), "--height",
+                     std::to_string(H), "-q", "--aov", "albedo,normal,depth,cut,shadow_rays"},
+                    dir.path());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string exr = dir.file("out.exr");
+  lc::io::Image img = lc::io::readImage(exr);  // the image is still R, G, B
+  ASSERT_EQ(img.width, W);
+  EXPECT_GT(lc::luminance(img.at(W / 2, H / 2)), 0.0f);
+  int w = 0, h = 0;
+  auto channel = [&](const std::string& name) {
+    std::vector<float> v = lc::io::readExrChannel(exr, name, w, h);
+    EXPECT_EQ(w, W);
+    EXPECT_EQ(h, H);
+    return v;
+  };
+  std::vector<float> ar = channel("albedo.R"), ag = channel("albedo.G"), ab = channel("albedo.B");
+  std::vector<float> nx = channel("normal.X"), ny = channel("normal.Y"), nz = channel("normal.Z");
+  std::vector<float> depth = channel("depth.Z"), cut = channel("cut.Y"), rays = channel("shadow_rays.Y");
+  const float tanHalf = std::tan(30.0f * 3.14159265f / 180.0f);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * W + size_t(x);
+      EXPECT_FLOAT_EQ(ar[i], 0.5f);
+      EXPECT_FLOAT_EQ(ag[i], 0.6f);
+      EXPECT_FLOAT_EQ(ab[i], 0.7f);
+      EXPECT_NEAR(nx[i], 0.0f, 1e-6f);
+      EXPECT_NEAR(ny[i], 0.0f, 1e-6f);
+      EXPECT_NEAR(nz[i], 1.0f, 1e-6f);
+      // The ray through the pixel centre: (a, b, -1) with a, b on the image plane at distance 1.
+      const float a = (2 * (float(x) + 0.5f) / W - 1) * tanHalf * float(W) / float(H);
+      const float b = (2 * (float(y) + 0.5f) / H - 1) * tanHalf;
+      EXPECT_NEAR(depth[i], 5.0f * std::sqrt(1 + a * a + b * b), 1e-3f) << x << "," << y;
+      EXPECT_FLOAT_EQ(cut[i], 1.0f);   // one light: a cut of one node
+      EXPECT_FLOAT_EQ(rays[i], 1.0f);  // and its shadow ray
+    }
+  // Names are checked; 8-bit outputs have no layers.
+  CliResult png = run({"render", "plane.ray", "-o", "out.png", "--width", "8", "-q", "--aov", "depth"}, dir.path());
+  EXPECT_EQ(png.status, 1);
+  EXPECT_EQ(png.err, "lightcuts: --aov needs an .exr output (its layers are extra EXR channels); 'out.png' is .png\n");
+  EXPECT_FALSE(fs::exists(dir.file("out.png")));
+  CliResult bad = run({"render", "plane.ray", "-o", "b.exr", "--width", "8", "-q", "--aov", "depth,alpha"}, dir.path());
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_NE(bad.err.find("--aov: unknown output 'alpha'"), std::string::npos) << bad.err;
+}
+
+// Antialiasing is on by default (--aa adaptive), off with --aa off, and a fixed --spp
+// count samples every pixel instead; the stats say which.
+TEST(CliOutput, AdaptiveAntialiasingByDefault) {
+  TempDir dir;
+  writeText(dir.file("s.ray"), kHeader + kLitFloor + "point_light { position = (2,4,3); }\n");
+  auto stats = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args{"render", "s.ray", "-o", "o.png", "--width", "32", "-q", "--stats", "s.json"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    CliResult r = run(args, dir.path());
+    EXPECT_EQ(r.status, 0) << r.err;
+    return nlohmann::json::parse(slurp(dir.file("s.json")));
+  };
+  nlohmann::json d = stats({});
+  EXPECT_EQ(d["aa"], "adaptive");
+  EXPECT_GT(d["aa_pixels"].get<int>(), 20);  // the sphere's outline
+  EXPECT_LT(d["aa_pixels"].get<int>(), 32 * 32 / 2);
+  EXPECT_EQ(d["primary_rays"].get<int>(), 32 * 32 + 8 * d["aa_pixels"].get<int>());
+  nlohmann::json off = stats({"--aa", "off"});
+  EXPECT_EQ(off["aa_pixels"].get<int>(), 0);
+  EXPECT_EQ(off["primary_rays"].get<int>(), 32 * 32);
+  nlohmann::json fixed = stats({"--spp", "4"});
+  EXPECT_EQ(fixed["aa"], "off");
+  EXPECT_EQ(fixed["primary_rays"].get<int>(), 4 * 32 * 32);
+  nlohmann::json more = stats({"--aa-samples", "24"});
+  EXPECT_EQ(more["primary_rays"].get<int>(), 32 * 32 + 24 * more["aa_pixels"].get<int>());
+  CliResult bad = run({"render", "s.ray", "-o", "b.png", "--width", "8", "-q", "--aa-samples", "16"}, dir.path());
+  EXPECT_NE(bad.status, 0);
+}

@@ -85,9 +85,10 @@ std::vector<char> receiveBytes(const MPI_Status& st) {
 }
 
 // A tile on the wire: its index, then per pixel (row by row) the colour and the cut size
-// as floats, then its done flags. Exact: the floats are copied, not converted.
+// and shadow rays (the --aov layers) as floats, then its done flags. Exact: the floats are
+// copied, not converted.
 struct PixelRecord {
-  float r, g, b, cut;
+  float r, g, b, cut, rays;
 };
 
 std::vector<char> packTile(int tile, const TileRect& t, const RenderResult& res) {
@@ -102,10 +103,11 @@ std::vector<char> packTile(int tile, const TileRect& t, const RenderResult& res)
     for (int x = t.x0; x < t.x1; ++x) {
       size_t i = size_t(y) * size_t(w) + size_t(x);
       const Color& c = res.image.pixels[i];
-      PixelRecord r{c.x, c.y, c.z, res.cutSize[i]};
+      PixelRecord r{c.x, c.y, c.z, res.cutSize[i], i < res.shadowRays.size() ? res.shadowRays[i] : 0.0f};
       std::memcpy(px, &r, sizeof r);
       px += sizeof r;
-      *done++ = char(res.done[i]);
+      // The done flag, and in bit 1 whether adaptive antialiasing re-sampled the pixel.
+      *done++ = char(res.done[i] | ((i < res.aaFlagged.size() ? res.aaFlagged[i] : 0) << 1));
     }
   return buf;
 }
@@ -130,7 +132,10 @@ bool unpackTile(const std::vector<char>& buf, const TileGrid& grid, RenderResult
       px += sizeof r;
       res.image.pixels[i] = Color(r.r, r.g, r.b);
       res.cutSize[i] = r.cut;
-      res.done[i] = uint8_t(*done++);
+      if (i < res.shadowRays.size()) res.shadowRays[i] = r.rays;
+      const uint8_t flags = uint8_t(*done++);
+      res.done[i] = flags & 1;
+      if (i < res.aaFlagged.size()) res.aaFlagged[i] = (flags >> 1) & 1;
     }
   return true;
 }

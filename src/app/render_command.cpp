@@ -1,6 +1,7 @@
 // `lightcuts render`: load, light, render, write the image, report.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -36,7 +37,10 @@ struct RenderArgs {
   std::string scene;
   std::string out;
   int width = 0, height = 0;
-  int spp = 1;
+  int spp = render::RenderOptions{}.spp;
+  std::string aa = render::antiAliasingName(render::RenderOptions{}.aa);
+  int aaSamples = render::RenderOptions{}.aaSamples;
+  std::string aov;  // comma-separated kAovNames
   int threads = 0;
   int maxDepth = 5;
   std::string stats;
@@ -93,6 +97,65 @@ int reconstructCoarseSpacing(const std::string& option, int spacing) {
     throw Error(fmt::format("--reconstruct-coarse {}: must be 0 or the reconstruction spacing ({}) times 2, 4, 8, ...",
                             c, spacing));
   return c;
+}
+
+// --aov: extra EXR layers, by name, with their channels.
+struct AovKind {
+  const char* name;
+  std::vector<const char*> channels;
+};
+const std::vector<AovKind> kAovs = {{"albedo", {"R", "G", "B"}},
+                                    {"normal", {"X", "Y", "Z"}},
+                                    {"depth", {"Z"}},
+                                    {"cut", {"Y"}},
+                                    {"shadow_rays", {"Y"}}};
+
+std::vector<std::string> parseAovs(const std::string& list) {
+  std::vector<std::string> out;
+  size_t start = 0;
+  while (start <= list.size()) {
+    size_t comma = list.find(',', start);
+    std::string name = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    bool known = false;
+    for (const AovKind& k : kAovs) known = known || name == k.name;
+    if (!known)
+      throw Error(fmt::format("--aov: unknown output '{}' (use albedo, normal, depth, cut, shadow_rays, "
+                              "comma-separated)",
+                              name));
+    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
+// The EXR channels of the requested AOVs ("albedo.R", ..., "depth.Z").
+std::vector<io::WriteOptions::Channel> aovChannels(const std::vector<std::string>& names, const scene::Scene& scene,
+                                                   const render::RenderOptions& ro, const render::RenderResult& rr) {
+  std::vector<io::WriteOptions::Channel> out;
+  const bool primary = std::any_of(names.begin(), names.end(),
+                                   [](const std::string& n) { return n == "albedo" || n == "normal" || n == "depth"; });
+  render::PixelAovs pa;
+  if (primary) pa = render::primaryAovs(scene, ro);
+  const size_t n = size_t(ro.width) * size_t(ro.height);
+  for (const std::string& name : names) {
+    if (name == "cut" || name == "shadow_rays") {
+      out.push_back({name + ".Y", name == "cut" ? rr.cutSize : rr.shadowRays});
+      continue;
+    }
+    if (name == "depth") {
+      out.push_back({"depth.Z", pa.depth});
+      continue;
+    }
+    const std::vector<Vec3>& v = name == "albedo" ? pa.albedo : pa.normal;
+    const char* axes = name == "albedo" ? "RGB" : "XYZ";
+    for (int c = 0; c < 3; ++c) {
+      io::WriteOptions::Channel ch{name + "." + axes[c], std::vector<float>(n)};
+      for (size_t i = 0; i < n; ++i) ch.values[i] = v[i][c];
+      out.push_back(std::move(ch));
+    }
+  }
+  return out;
 }
 
 // Text metadata of the output image: what made it and from what.
@@ -174,6 +237,9 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
     throw Error("cannot write '" + a.out + "': no file extension to choose the format (use .png, .ppm, .bmp or .exr)");
   if (!io::isWritableImageExtension(ext))
     throw Error("cannot write '" + a.out + "': unknown image format '." + ext + "' (use .png, .ppm, .bmp or .exr)");
+  const std::vector<std::string> aovs = a.aov.empty() ? std::vector<std::string>{} : parseAovs(a.aov);
+  if (!aovs.empty() && ext != "exr")
+    throw Error("--aov needs an .exr output (its layers are extra EXR channels); '" + a.out + "' is ." + ext);
   // Fail before a long render, not after it (only rank 0 writes).
   if (root) {
     checkWritable(a.out);
@@ -278,6 +344,8 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
   ro.width = a.width;
   ro.height = a.height;
   ro.spp = a.spp;
+  ro.aa = render::parseAntiAliasing(a.aa);
+  ro.aaSamples = a.aaSamples;
   ro.threads = a.threads;
   ro.maxDepth = a.maxDepth;
   ro.seed = a.seed;
@@ -350,6 +418,7 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
   wo.tonemap = tonemap;
   wo.exposure = a.exposure;
   wo.metadata = metadata(a);
+  wo.channels = aovChannels(aovs, scene, ro, rr);
   if (ext != "exr") {
     wo.metadata.emplace_back("Tone map", a.tonemap);
     wo.metadata.emplace_back("Exposure", fmt::format("{:g}", a.exposure));
@@ -384,6 +453,10 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
     j["width"] = a.width;
     j["height"] = a.height;
     j["spp"] = a.spp;
+    j["aa"] = a.spp == 1 ? a.aa : "off";
+    j["aa_samples"] = a.aaSamples;
+    j["aa_pixels"] = rr.stats.aaPixels;
+    j["aa_sub_samples"] = rr.stats.aaSubSamples;
     j["threads"] = a.threads > 0 ? a.threads : int(std::thread::hardware_concurrency());
     j["method"] = lightcuts::methodName(method);
     j["error_threshold"] = error;
@@ -497,7 +570,13 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
                  lightcuts::methodName(method), lightcuts::treeBuilderName(tb.builder), forest.nodeCount(),
                  double(forest.memoryBytes()) / (1 << 20), formatSeconds(forest.buildSeconds), error,
                  method == lightcuts::Method::Lightcuts ? " (" + a.criterion + " criterion)" : "", a.maxCut);
-    fmt::print("image      {}x{}, {} spp -> {}\n", a.width, a.height, a.spp, a.out);
+    fmt::print("image      {}x{}, {} spp{} -> {}\n", a.width, a.height, a.spp,
+               ro.spp == 1 && ro.aa == render::AntiAliasing::Adaptive
+                   ? fmt::format(", adaptive antialiasing: {} pixels ({:.1f}%) re-sampled {} times",
+                                 formatCount(double(rr.stats.aaPixels)),
+                                 100.0 * double(rr.stats.aaPixels) / (double(a.width) * double(a.height)), ro.aaSamples)
+                   : std::string(),
+               a.out);
     if (distributed) {
       std::string tiles, busy;
       for (const auto& r : perRank) {
@@ -578,9 +657,35 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--height", a->height, "Image height in pixels; default the width / the camera's aspect ratio")
       ->check(CLI::Range(1, kMaxImageSide))
       ->group(image);
-  c->add_option("--spp", a->spp, fmt::format("Samples per pixel, stratified (1 = pixel centre); default {}", d.spp))
+  c->add_option("--spp", a->spp,
+                fmt::format("Samples per pixel, stratified (1 = the pixel centre, antialiased by --aa); more = that "
+                            "many at every pixel, --aa aside; default {}",
+                            d.spp))
       ->check(CLI::Range(1, 65536))
       ->group(image);
+  {
+    const render::RenderOptions ro;
+    c->add_option("--aa", a->aa,
+                  fmt::format("Antialiasing with --spp 1: adaptive (a pixel whose centre ray differs from a "
+                              "neighbour's in shape, in normal by more than {:.0f} degrees, or in luminance by more "
+                              "than {:g}% is re-sampled with --aa-samples stratified sub-samples) or off (the pixel "
+                              "centre only); default {}",
+                              std::acos(ro.aaNormalCos) * 180 / kPi, 100 * ro.aaContrast, d.aa))
+        ->check(CLI::IsMember({"adaptive", "off"}))
+        ->group(image);
+    c->add_option("--aa-samples", a->aaSamples,
+                  fmt::format("Adaptive antialiasing: sub-samples at a re-sampled pixel, with its centre a g x g "
+                              "stratified grid: 8 (3 x 3), 24 (5 x 5) or 48 (7 x 7); default {}",
+                              d.aaSamples))
+        ->check(CLI::IsMember({8, 24, 48}))
+        ->group(image);
+  }
+  c->add_option("--aov", a->aov,
+                "Extra outputs as layers of the .exr output, comma-separated: albedo (albedo.R/G/B: the diffuse "
+                "colour at the pixel centre's hit), normal (normal.X/Y/Z: its shading normal, facing the camera), "
+                "depth (depth.Z: distance along the camera ray, inf for none), cut (cut.Y: lights in the cut per "
+                "sample), shadow_rays (shadow_rays.Y: per sample); the image stays R, G, B; default none")
+      ->group(output);
   c->add_option("--max-depth", a->maxDepth, fmt::format("Reflection/refraction recursion depth; default {}", d.maxDepth))
       ->check(CLI::Range(0, 64))
       ->group(image);

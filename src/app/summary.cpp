@@ -65,6 +65,8 @@ nlohmann::json renderCountersJson(const render::RenderStats& st) {
   j["reconstruction_samples"] = st.reconstructionSamples;
   j["reconstruction_fallbacks"] = st.reconstructionFallbacks;
   j["reconstruction_coarse_cells"] = st.reconstructionCoarseCells;
+  j["aa_pixels"] = st.aaPixels;
+  j["aa_sub_samples"] = st.aaSubSamples;
   return j;
 }
 
@@ -78,6 +80,8 @@ void addRenderCounters(render::RenderStats& st, const nlohmann::json& j) {
   st.reconstructionSamples += j.at("reconstruction_samples").get<uint64_t>();
   st.reconstructionFallbacks += j.at("reconstruction_fallbacks").get<uint64_t>();
   st.reconstructionCoarseCells += j.at("reconstruction_coarse_cells").get<uint64_t>();
+  st.aaPixels += j.at("aa_pixels").get<uint64_t>();
+  st.aaSubSamples += j.at("aa_sub_samples").get<uint64_t>();
 }
 
 }  // namespace lc::app

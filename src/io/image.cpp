@@ -79,7 +79,8 @@ std::vector<uint8_t> encodePpm(const Image& img, const std::vector<uint8_t>& rgb
   return out;
 }
 
-void writeExr(const std::string& tmp, const std::string& path, const Image& img, const TextMetadata& metadata) {
+void writeExr(const std::string& tmp, const std::string& path, const Image& img, const TextMetadata& metadata,
+              const std::vector<WriteOptions::Channel>& channels) {
   // NaN -> 0 as in the 8-bit formats; infinities are kept (EXR can hold them).
   std::vector<Color> px(img.pixels);
   for (Color& c : px)
@@ -90,12 +91,16 @@ void writeExr(const std::string& tmp, const std::string& path, const Image& img,
     // 32-bit float channels: the round trip is exact (half would lose precision).
     for (const char* ch : {"R", "G", "B"}) header.channels().insert(ch, Imf::Channel(Imf::FLOAT));
     for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
+    for (const WriteOptions::Channel& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
     Imf::FrameBuffer fb;
     const size_t xs = sizeof(Color), ys = sizeof(Color) * size_t(img.width);
     char* base = reinterpret_cast<char*>(px.data());
     fb.insert("R", Imf::Slice(Imf::FLOAT, base + offsetof(Color, x), xs, ys));
     fb.insert("G", Imf::Slice(Imf::FLOAT, base + offsetof(Color, y), xs, ys));
     fb.insert("B", Imf::Slice(Imf::FLOAT, base + offsetof(Color, z), xs, ys));
+    for (const WriteOptions::Channel& c : channels)
+      fb.insert(c.name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(c.values.data())),
+                                   sizeof(float), sizeof(float) * size_t(img.width)));
     Imf::OutputFile file(tmp.c_str(), header);
     file.setFrameBuffer(fb);
     file.writePixels(img.height);
@@ -166,6 +171,30 @@ Image readExr(const std::string& path, uint64_t maxPixels) {
     throwDecode(path, e.what());
   }
 }
+
+}  // namespace
+
+std::vector<float> readExrChannel(const std::string& path, const std::string& name, int& width, int& height) {
+  try {
+    Imf::InputFile file(path.c_str());
+    const Imath::Box2i dw = file.header().dataWindow();
+    width = dw.max.x - dw.min.x + 1;
+    height = dw.max.y - dw.min.y + 1;
+    if (!file.header().channels().findChannel(name)) throwDecode(path, "no channel '" + name + "'");
+    std::vector<float> v(size_t(width) * size_t(height));
+    Imf::FrameBuffer fb;
+    fb.insert(name, Imf::Slice::Make(Imf::FLOAT, v.data(), dw, sizeof(float), sizeof(float) * size_t(width)));
+    file.setFrameBuffer(fb);
+    file.readPixels(dw.min.y, dw.max.y);
+    return v;
+  } catch (const ImageReadError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throwDecode(path, e.what());
+  }
+}
+
+namespace {
 
 // stb sets a reason with every failure, but a null would crash std::string.
 std::string stbiReason() {
@@ -687,8 +716,17 @@ void writeImage(const std::string& path, const Image& image, const WriteOptions&
     throw Error("cannot write " + quoteInput(path) + ": pixel count does not match " +
                 std::to_string(image.width) + "x" + std::to_string(image.height));
 
+  for (const WriteOptions::Channel& c : options.channels) {
+    if (ext != "exr")
+      throw Error("cannot write " + quoteInput(path) + ": channel '" + c.name + "' needs an .exr output");
+    if (c.values.size() != image.pixels.size())
+      throw Error("cannot write " + quoteInput(path) + ": channel '" + c.name + "' does not match the image size");
+    if (c.name.empty() || c.name == "R" || c.name == "G" || c.name == "B")
+      throw Error("cannot write " + quoteInput(path) + ": bad channel name '" + c.name + "'");
+  }
   if (ext == "exr") {
-    writeFileAtomically(path, [&](const std::string& tmp) { writeExr(tmp, path, image, options.metadata); });
+    writeFileAtomically(path,
+                        [&](const std::string& tmp) { writeExr(tmp, path, image, options.metadata, options.channels); });
     return;
   }
   // Encode in memory first so that file errors come from our own writes (with errno)

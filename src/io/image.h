@@ -42,6 +42,14 @@ struct WriteOptions {
   // value is not ASCII); PPM and BMP have no place for it. Keys are 1..79 printable ASCII
   // characters.
   TextMetadata metadata;
+  // EXR only: more float channels beside R, G, B, each width x height values, row-major,
+  // named as OpenEXR layers are ("albedo.R", "depth.Z"); the main image stays R, G, B, so
+  // readers that know nothing of layers read it as before. Other formats refuse them.
+  struct Channel {
+    std::string name;
+    std::vector<float> values;
+  };
+  std::vector<Channel> channels;
 };
 
 // Writes by extension: .png .ppm .bmp (8-bit) or .exr (float). Throws lc::Error
@@ -81,6 +89,10 @@ class ImageReadError : public Error {
 //   "image 'path' is WxH = N pixels, more than the limit of M"
 Image readImage(const std::string& path, bool srgb = false,
                 uint64_t maxPixels = Limits{}.maxTexturePixels);
+
+// One float channel of an EXR file by name ("depth.Z"), width x height values row-major
+// (width and height are set). Throws ImageReadError when the file or the channel is missing.
+std::vector<float> readExrChannel(const std::string& path, const std::string& name, int& width, int& height);
 
 // sRGB transfer functions on [0,1] (values outside are clamped).
 float srgbToLinear(float v);

@@ -30,6 +30,7 @@ Loaded loadCornell() {
 RenderResult renderWith(const scene::Scene& s, const lightcuts::LightEvaluator& ev, int w, int reconstruct = 0,
                         int coarse = 0) {
   RenderOptions o;
+  o.aa = AntiAliasing::Off;  // checked at pixel centres (closed forms, per-pixel comparisons)
   o.width = o.height = w;
   o.reconstructSpacing = reconstruct;
   o.reconstructCoarseSpacing = coarse;

@@ -31,6 +31,7 @@ RenderResult renderLightcuts(const scene::Scene& s, int w, int threads = 0,
   co.errorRatio = error;
   auto ev = lightcuts::makeLightcuts(s.lights(), forest, co);
   RenderOptions o;
+  o.aa = AntiAliasing::Off;  // checked at pixel centres (closed forms, per-pixel comparisons)
   o.width = o.height = w;
   o.threads = threads;
   return render(s, *ev, o);
@@ -93,6 +94,7 @@ TEST(EnvironmentFurnace, BruteForceAgreesAndThreadCountDoesNotMatter) {
   auto s = load(furnace(2048));
   auto brute = lightcuts::makeBruteForce(s->lights());
   RenderOptions o;
+  o.aa = AntiAliasing::Off;  // checked at pixel centres (closed forms, per-pixel comparisons)
   o.width = o.height = 24;
   RenderResult b = render(*s, *brute, o);
   RenderResult one = renderLightcuts(*s, 24, 1), two = renderLightcuts(*s, 24, 2);
@@ -128,6 +130,7 @@ sphere { material = { specular = (0.25, 0.25, 0.25); shininess = 0; }; }
 )");
   auto brute = lightcuts::makeBruteForce(s->lights());
   RenderOptions o;
+  o.aa = AntiAliasing::Off;  // checked at pixel centres (closed forms, per-pixel comparisons)
   o.width = o.height = 16;
   RenderResult r = render(*s, *brute, o);
   for (int y = 0; y < 16; ++y)

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <climits>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include <time.h>
 
 #include "core/rng.h"
+#include "render/adaptive.h"
 
 namespace lc::render {
 
@@ -159,7 +161,13 @@ bool sameSurface(int shapeA, const Vec3& pa, const Vec3& na, int shapeB, const V
 struct CellCuts {
   lightcuts::MergedCut merged[16];
   bool ready[16] = {};
-  void reset() { std::fill(std::begin(ready), std::end(ready), false); }
+  // Antialiasing's sub-samples: the samples the merged cuts are of (count -1: unknown).
+  int aaCount = -1;
+  const CutSample* aaSamples[4] = {};
+  void reset() {
+    std::fill(std::begin(ready), std::end(ready), false);
+    aaCount = -1;
+  }
 };
 
 // What happens at a primary hit (depth 0) under reconstruction cuts.
@@ -172,6 +180,7 @@ struct PrimaryHook {
   float maxSeparation = kInf;  // how far a sample may be, over the point's distance to it
   int px = 0, py = 0;         // the pixel, and
   int cx[4] = {}, cy[4] = {};  // the samples' pixels
+  bool preselected = false;  // samples chosen for this very hit (antialiasing): no hull test
   uint64_t fallbacks = 0;  // hits no sample could serve: they got a full lightcut
 };
 
@@ -220,7 +229,7 @@ unsigned matchingSamples(const PrimaryHook& h, int shape, const Vec3& p, const V
 // between them.
 unsigned servingSamples(const PrimaryHook& h, int shape, const Vec3& p, const Vec3& n) {
   unsigned mask = matchingSamples(h, shape, p, n);
-  return mask != 0 && insideSamples(h, mask) ? mask : 0;
+  return mask != 0 && (h.preselected || insideSamples(h, mask)) ? mask : 0;
 }
 
 struct Tracer {
@@ -332,11 +341,13 @@ Vec2 samplePosition(int s, int spp, Rng& rng) {
 struct PixelResult {
   Color color;
   float cut = 0;
+  float shadowRays = 0;  // per sample
 };
 
 PixelResult renderPixel(const Scene& scene, const LightEvaluator& ev, const RenderOptions& o, int x, int y,
                         EvalStats& stats, uint64_t& primary, uint64_t& secondary, PrimaryHook* hook = nullptr) {
   Rng rng(o.seed, uint64_t(y) * uint64_t(o.width) + uint64_t(x));
+  const uint64_t rays0 = stats.shadowRays;
   Tracer tr{scene, ev, o.maxDepth, stats, hook};
   tr.errorFloor = std::max(0.0f, o.errorFloor);
   Color sum(0);
@@ -351,13 +362,14 @@ PixelResult renderPixel(const Scene& scene, const LightEvaluator& ev, const Rend
     sum += c;
   }
   secondary += tr.secondaryRays;
-  return {sum / float(o.spp), float(tr.cutNodes) / float(o.spp)};
+  return {sum / float(o.spp), float(tr.cutNodes) / float(o.spp), float(stats.shadowRays - rays0) / float(o.spp)};
 }
 
 void storePixel(RenderResult& res, int width, int x, int y, const PixelResult& p) {
   size_t i = size_t(y) * size_t(width) + size_t(x);
   res.image.pixels[i] = p.color;
   res.cutSize[i] = p.cut;
+  res.shadowRays[i] = p.shadowRays;
   res.done[i] = 1;
 }
 
@@ -604,6 +616,195 @@ struct ReconstructionTile {
   }
 };
 
+// Adaptive antialiasing (RenderOptions::aa, render/adaptive.h). What a pixel's sub-samples
+// add: their radiance, cut nodes and shadow rays, summed.
+// The merged cuts of the last few sets of samples sub-samples borrowed from (neighbouring
+// sub-samples, and pixels, mostly borrow from the same ones), replaced in turn.
+struct AaCutCache {
+  static constexpr int kEntries = 8;
+  CellCuts entries[kEntries];
+  int next = 0;
+  void reset() {
+    for (CellCuts& e : entries) e.reset();
+    next = 0;
+  }
+  CellCuts* find(const CutSample* const* set, int k) {
+    for (CellCuts& e : entries)
+      if (e.aaCount == k && std::equal(set, set + k, e.aaSamples)) return &e;
+    CellCuts& e = entries[next];
+    next = (next + 1) % kEntries;
+    e.reset();
+    e.aaCount = k;
+    std::copy(set, set + k, e.aaSamples);
+    return &e;
+  }
+};
+
+struct SubSampleSums {
+  Color color{0};
+  double cut = 0, shadowRays = 0;
+  int count = 0;
+  uint64_t fallbacks = 0;  // sub-samples no reconstruction sample could serve
+};
+
+// The sub-samples of pixel (x, y) on the g x g grid. Under reconstruction cuts (rt), each
+// borrows from the tile's samples on its surface: the nearest one in each quadrant around
+// the sub-sample's own position within two cells, used when the sub-sample lies between
+// them (tested at 1/16 pixel) or one of them is a neighbouring pixel (samples gather along
+// edges, where a sub-sample may hit the surface beyond); else it gets a full lightcut.
+// (Quadrants around the pixel instead let the pixel's own sample, where it is one, win all
+// four, and sub-samples on a contact line borrowed from it alone: up to 13% off.)
+SubSampleSums traceSubSamples(const Scene& scene, const LightEvaluator& ev, const RenderOptions& o, int x, int y,
+                              int g, EvalStats& stats, uint64_t& primary, uint64_t& secondary,
+                              const ReconstructionTile* rt, AaCutCache* cache) {
+  SubSampleSums sums;
+  Rng rng(o.seed, aaStream(x, y, o.width, o.height));
+  const scene::Camera& cam = scene.camera();
+  for (int s = 0; s < g * g - 1; ++s) {
+    Vec2 u = aaSubSamplePosition(s, g, rng);
+    Ray ray{cam.eye, normalize(cam.direction((float(x) + u.x) / float(o.width), (float(y) + u.y) / float(o.height))), 0,
+            kInf};
+    PrimaryHook hook;
+    const CutSample* chosen[4];
+    if (rt) {
+      hook.samples = chosen;
+      hook.eye = cam.eye;
+      hook.maxSeparation = rt->maxSeparation;
+      // Hull tests at the sub-sample's own position, in 1/kSub pixel units (sample pixels
+      // at their centres).
+      constexpr int kSub = 16;
+      hook.px = x * kSub + std::min(kSub - 1, int(u.x * float(kSub)));
+      hook.py = y * kSub + std::min(kSub - 1, int(u.y * float(kSub)));
+      hook.preselected = true;
+      Hit hit;
+      if (scene.intersect(ray, hit)) {
+        const float far2 = length2(hit.p - cam.eye) * rt->maxSeparation * rt->maxSeparation;
+        const int R = 2 * std::max(1, rt->spacing);
+        int bd[4] = {INT32_MAX, INT32_MAX, INT32_MAX, INT32_MAX}, bx[4] = {}, by[4] = {};
+        const CutSample* best[4] = {};
+        for (int Y = std::max(rt->y0, y - R); Y <= std::min({rt->y1, y + R, o.height - 1}); ++Y)
+          for (int X = std::max(rt->x0, x - R); X <= std::min({rt->x1, x + R, o.width - 1}); ++X) {
+            const CutSample* cs = rt->shared[rt->slot(X, Y)];
+            if (!cs || !cs->cut.valid || !sameSurface(hit.shape, hit.p, hit.ns, cs->shape, cs->p, cs->n) ||
+                length2(cs->p - hit.p) > far2)
+              continue;
+            // Quadrants and distances around the sub-sample's own position.
+            const int dx = X * kSub + kSub / 2 - hook.px, dy = Y * kSub + kSub / 2 - hook.py, d = dx * dx + dy * dy;
+            for (int q = 0; q < 4; ++q)
+              if (((q & 1) ? dx >= 0 : dx <= 0) && ((q & 2) ? dy >= 0 : dy <= 0) && d < bd[q]) {
+                bd[q] = d;
+                best[q] = cs;
+                bx[q] = X;
+                by[q] = Y;
+              }
+          }
+        // Distinct, in image order (one set, one order: its merged cuts are cached).
+        int order[4], n = 0;
+        for (int q = 0; q < 4; ++q) {
+          bool dup = !best[q];
+          for (int j = 0; j < n && !dup; ++j) dup = best[order[j]] == best[q];
+          if (!dup) order[n++] = q;
+        }
+        for (int i = 1; i < n; ++i)  // insertion sort by (y, x)
+          for (int j = i; j > 0 && (by[order[j]] < by[order[j - 1]] ||
+                                    (by[order[j]] == by[order[j - 1]] && bx[order[j]] < bx[order[j - 1]]));
+               --j)
+            std::swap(order[j], order[j - 1]);
+        int k = 0, nearest = INT32_MAX;
+        for (int j = 0; j < n; ++j) {
+          const int q = order[j];
+          chosen[k] = best[q];
+          hook.cx[k] = bx[q] * kSub + kSub / 2;
+          hook.cy[k] = by[q] * kSub + kSub / 2;
+          nearest = std::min(nearest, std::max(std::abs(bx[q] - x), std::abs(by[q] - y)));
+          ++k;
+        }
+        hook.count = k;
+        if (k > 0 && !(nearest <= 1 || insideSamples(hook, (1u << k) - 1))) hook.count = 0;
+      }
+      hook.cell = cache->find(chosen, hook.count);
+    }
+    Tracer tr{scene, ev, o.maxDepth, stats, rt ? &hook : nullptr};
+    const uint64_t rays0 = stats.shadowRays;
+    ++primary;
+    Color c = tr.trace(ray, 0);
+    if (!isFinite(c)) c = Color(0);
+    sums.color += c;
+    sums.cut += double(tr.cutNodes);
+    sums.shadowRays += double(stats.shadowRays - rays0);
+    secondary += tr.secondaryRays;
+    sums.fallbacks += hook.fallbacks;
+    ++sums.count;
+  }
+  return sums;
+}
+
+// The tile [x0, x1) x [y0, y1) after its centre samples: flags the pixels whose centres
+// disagree with a neighbour's and re-samples them. Every input is the tile's own (its
+// pixels, its samples, centre rays probed around it), so the result does not depend on
+// the order tiles run in.
+void adaptiveTile(const Scene& scene, const LightEvaluator& ev, const RenderOptions& o, RenderResult& res,
+                  EvalStats& stats, uint64_t& primary, uint64_t& secondary, uint64_t& aaPixels, uint64_t& aaSubs,
+                  uint64_t& fallbacks, int x0, int y0, int x1, int y1, const ReconstructionTile* rt,
+                  AaCutCache* cache) {
+  if (o.aa != AntiAliasing::Adaptive || o.spp != 1) return;
+  const int g = aaGridSide(o.aaSamples);
+  if (g == 0) return;
+  if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
+  const int w = x1 - x0, h = y1 - y0;
+  std::vector<CentreSample> ring(size_t(w + 2) * size_t(h + 2));
+  const scene::Camera& cam = scene.camera();
+  for (int y = y0 - 1; y <= y1; ++y)
+    for (int x = x0 - 1; x <= x1; ++x) {
+      CentreSample& c = ring[size_t(y - y0 + 1) * size_t(w + 2) + size_t(x - x0 + 1)];
+      if (x < 0 || y < 0 || x >= o.width || y >= o.height) {
+        c.shape = -2;
+        continue;
+      }
+      Ray ray{cam.eye, normalize(cam.direction((float(x) + 0.5f) / float(o.width), (float(y) + 0.5f) / float(o.height))),
+              0, kInf};
+      Hit hit;
+      if (scene.intersect(ray, hit)) {
+        c.shape = hit.shape;
+        c.n = hit.ns;
+      }
+      if (x >= x0 && x < x1 && y >= y0 && y < y1) {
+        c.known = true;
+        c.luminance = std::min(1.0f, luminance(res.image.pixels[size_t(y) * size_t(o.width) + size_t(x)]));
+      }
+    }
+  const std::vector<uint8_t> flags = flagPixels(ring, w, h, o);
+  if (cache) cache->reset();  // its merged cuts may be of another tile's samples
+  const float n = float(g * g);
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
+      if (!flags[size_t(y - y0) * size_t(w) + size_t(x - x0)]) continue;
+      if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
+      SubSampleSums sub = traceSubSamples(scene, ev, o, x, y, g, stats, primary, secondary, rt, cache);
+      size_t i = size_t(y) * size_t(o.width) + size_t(x);
+      res.image.pixels[i] = (res.image.pixels[i] + sub.color) / n;
+      res.cutSize[i] = float((double(res.cutSize[i]) + sub.cut) / double(n));
+      res.shadowRays[i] = float((double(res.shadowRays[i]) + sub.shadowRays) / double(n));
+      res.aaFlagged[i] = 1;
+      ++aaPixels;
+      aaSubs += uint64_t(sub.count);
+      fallbacks += sub.fallbacks;
+    }
+}
+
+// A pixel as the render made it, with another evaluator (brute force for the reference
+// pixels, apples to apples): the centre sample, and where antialiasing re-sampled the
+// pixel, the same sub-samples (same positions), each with a full evaluation.
+Color pixelWithSubSamples(const Scene& scene, const LightEvaluator& ev, const RenderOptions& o, const RenderResult& res,
+                          int x, int y, EvalStats& stats) {
+  uint64_t a = 0, b = 0;
+  Color c = renderPixel(scene, ev, o, x, y, stats, a, b).color;
+  if (!res.aaFlagged[size_t(y) * size_t(o.width) + size_t(x)]) return c;
+  const int g = aaGridSide(o.aaSamples);
+  SubSampleSums sub = traceSubSamples(scene, ev, o, x, y, g, stats, a, b, nullptr, nullptr);
+  return (c + sub.color) / float(g * g);
+}
+
 // K pixels spread over the image (Halton 2,3), without duplicates.
 std::vector<std::pair<int, int>> referencePixelSet(int k, int w, int h) {
   std::vector<std::pair<int, int>> px;
@@ -667,6 +868,30 @@ double vplClampedFraction(const Scene& scene, const RenderOptions& o, int points
     b += unclamped[i];
   }
   return b > 0 ? std::max(0.0, 1 - a / b) : 0;
+}
+
+PixelAovs primaryAovs(const Scene& scene, const RenderOptions& o) {
+  PixelAovs a;
+  const size_t n = size_t(o.width) * size_t(o.height);
+  a.albedo.assign(n, Color(0));
+  a.normal.assign(n, Vec3(0, 0, 0));
+  a.depth.assign(n, kInf);
+  std::unique_ptr<tbb::global_control> threads;
+  if (o.threads > 0)
+    threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
+  const scene::Camera& cam = scene.camera();
+  tbb::parallel_for(0, o.height, [&](int y) {
+    for (int x = 0; x < o.width; ++x) {
+      Vec3 d = normalize(cam.direction((float(x) + 0.5f) / float(o.width), (float(y) + 0.5f) / float(o.height)));
+      Hit h;
+      if (!scene.intersect(Ray{cam.eye, d, 0, kInf}, h)) continue;
+      size_t i = size_t(y) * size_t(o.width) + size_t(x);
+      a.albedo[i] = scene.shadingMaterial(h).kd;
+      a.normal[i] = h.ns;
+      a.depth[i] = h.t;
+    }
+  });
+  return a;
 }
 
 Color traceRay(const Scene& scene, const LightEvaluator& evaluator, const Ray& ray, int maxDepth,
@@ -737,6 +962,8 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   res.image = io::Image(o.width, o.height);
   res.cutSize.assign(size_t(o.width) * size_t(o.height), 0.0f);
   res.done.assign(size_t(o.width) * size_t(o.height), 0);
+  res.shadowRays.assign(size_t(o.width) * size_t(o.height), 0.0f);
+  res.aaFlagged.assign(size_t(o.width) * size_t(o.height), 0);
   std::unique_ptr<tbb::global_control> threads;
   if (o.threads > 0)
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
@@ -751,6 +978,8 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     uint64_t coarseCells = 0;
     uint64_t tiles = 0, pixels = 0;
     CellCuts cell;                  // merged cuts of the current cell
+    uint64_t aaPixels = 0, aaSubs = 0;
+    AaCutCache aaCache;             // merged cuts of antialiasing's sub-samples
   };
   tbb::enumerable_thread_specific<Local> locals;
   // Reconstruction cuts: samples at the pixels whose x and y are multiples of S (and the
@@ -800,10 +1029,14 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
           if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return false;
           storePixel(res, o.width, x, y, renderPixel(scene, evaluator, o, x, y, L.stats, L.primary, L.secondary));
         }
+      adaptiveTile(scene, evaluator, o, res, L.stats, L.primary, L.secondary, L.aaPixels, L.aaSubs, L.fallbacks, x0, y0,
+                   x1, y1, nullptr, nullptr);
     } else {
       ReconstructionTile rt{scene, evaluator, o, centre, L.stats, L.primary, L.secondary, L.samples, L.fallbacks,
                             L.coarseCells, L.slots, L.slotState, L.slotSample, L.cell, res, edges, x0, y0, x1, y1};
       rt.run(S, C);
+      adaptiveTile(scene, evaluator, o, res, L.stats, L.primary, L.secondary, L.aaPixels, L.aaSubs, L.fallbacks, x0, y0,
+                   x1, y1, &rt, &L.aaCache);
       edges.tileDone(x0, y0, x1, y1);
       if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return false;
     }
@@ -858,6 +1091,8 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     res.stats.reconstructionCoarseCells += L.coarseCells;
     res.stats.tiles += L.tiles;
     res.stats.pixels += L.pixels;
+    res.stats.aaPixels += L.aaPixels;
+    res.stats.aaSubSamples += L.aaSubs;
   }
 
   // Brute force at sampled pixels: the measured error, and what a full brute-force image
@@ -867,7 +1102,6 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     auto px = referencePixelSet(o.referencePixels, o.width, o.height);
     std::vector<Color> ref(px.size()), test(px.size());
     EvalStats bruteStats, testStats;
-    uint64_t dummyA = 0, dummyB = 0;
     auto tb = Clock::now();
     tbb::enumerable_thread_specific<EvalStats> bs;
     // A distributed render computes its share here (every pixel's colour depends only on
@@ -879,13 +1113,23 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     tbb::parallel_for(size_t(0), px.size(), [&](size_t i) {
       if (!mine(i)) return;
       if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
-      uint64_t a = 0, b = 0;
-      ref[i] = renderPixel(scene, *brute, o, px[i].first, px[i].second, bs.local(), a, b).color;
+      ref[i] = pixelWithSubSamples(scene, *brute, o, res, px[i].first, px[i].second, bs.local());
       progress.add(1);
     });
     progress.finish();
     for (const EvalStats& s : bs) bruteStats.add(s);
-    if (share && !(o.cancel && o.cancel->load())) share->gatherReference(ref, bruteStats);
+    if (share && !(o.cancel && o.cancel->load())) {
+      share->gatherReference(ref, bruteStats);
+      // Another rank knew which pixels adaptive antialiasing re-sampled only in its own
+      // tiles; the gathering process, which has every tile now, redoes the other flagged
+      // ones at their sub-samples.
+      if (share->gathers()) {
+        EvalStats redo;
+        for (size_t i = 0; i < px.size(); ++i)
+          if (!mine(i) && res.aaFlagged[size_t(px[i].second) * size_t(o.width) + size_t(px[i].first)])
+            ref[i] = pixelWithSubSamples(scene, *brute, o, res, px[i].first, px[i].second, redo);
+      }
+    }
     // Stopped during the reference: the image is whole, but the run is interrupted.
     if (o.cancel && o.cancel->load()) {
       res.interrupted = true;
@@ -903,7 +1147,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     } else {
       auto tt = Clock::now();
       for (size_t i = 0; i < px.size(); ++i)
-        (void)renderPixel(scene, evaluator, o, px[i].first, px[i].second, testStats, dummyA, dummyB);
+        (void)pixelWithSubSamples(scene, evaluator, o, res, px[i].first, px[i].second, testStats);
       res.stats.reference.testSeconds = secondsSince(tt);
     }
     ReferenceStats& rs = res.stats.reference;

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "core/progress.h"
@@ -20,10 +21,39 @@ namespace lc::render {
 
 class WorkShare;
 
+// Antialiasing when spp == 1 (a fixed --spp N > 1 samples every pixel N times instead).
+enum class AntiAliasing {
+  Off,       // one sample per pixel, at its centre
+  Adaptive,  // the centre, then more samples only where neighbouring centres disagree
+};
+
+// "adaptive", "off" and back; parse throws lc::Error on other names.
+const char* antiAliasingName(AntiAliasing aa);
+AntiAliasing parseAntiAliasing(const std::string& name);
+
 struct RenderOptions {
   int width = 512;
   int height = 512;
-  int spp = 1;        // samples per pixel, stratified; 1 = the pixel centre
+  int spp = 1;        // samples per pixel, stratified; 1 = the pixel centre (see aa)
+  // Adaptive antialiasing (render/adaptive.h), with spp == 1: after a tile's centre samples,
+  // a pixel is flagged when one of its 8 neighbours' centre rays
+  //   - hits another shape (or nothing where it hits something): a silhouette or crease;
+  //   - hits the same shape with a shading normal more than acos(aaNormalCos) away: an
+  //     edge between faces of one mesh;
+  //   - differs in luminance (each clamped to 1, as displayed) by more than aaContrast of
+  //     the larger (at least aaContrastFloor): a shadow or texture boundary, an edge seen
+  //     in a mirror. (Luminance is compared within the tile only: a neighbour across a
+  //     tile border is not rendered yet; geometry is compared across borders.)
+  // A flagged pixel is re-sampled on a g x g stratified grid (jittered, its own random
+  // stream, so the image is the same at any thread count): the centre sample stands for
+  // the middle stratum, aaSamples = g^2 - 1 new sub-samples fill the others, and the pixel
+  // is their mean. Sub-samples borrow the tile's reconstruction samples where they lie on
+  // the same surface (else a full lightcut). Measured on the demo (docs/LIGHTCUTS.md).
+  AntiAliasing aa = AntiAliasing::Adaptive;
+  int aaSamples = 8;             // g^2 - 1 for odd g: 8 (3 x 3), 24 (5 x 5) or 48 (7 x 7)
+  float aaContrast = 0.25f;      // relative luminance contrast that flags a pixel (docs/LIGHTCUTS.md)
+  float aaContrastFloor = 0.02f; // luminance below which differences do not count relative
+  float aaNormalCos = 0.9f;      // cos of the normal difference that flags (~25 degrees)
   int threads = 0;    // 0 = all cores
   int maxDepth = 5;   // reflection/refraction recursion depth
   uint64_t seed = 1;
@@ -91,6 +121,8 @@ struct RenderStats {
   uint64_t reconstructionFallbacks = 0;  // primary hits whose samples did not match: full cuts
   uint64_t reconstructionCoarseCells = 0;  // cells of reconstructCoarseSpacing kept whole
   uint64_t secondaryRays = 0;  // reflection and refraction
+  uint64_t aaPixels = 0;       // pixels re-sampled by adaptive antialiasing
+  uint64_t aaSubSamples = 0;   // their extra camera rays (also in primaryRays)
   lightcuts::EvalStats eval;
   ReferenceStats reference;
 };
@@ -98,6 +130,8 @@ struct RenderStats {
 struct RenderResult {
   io::Image image;
   std::vector<float> cutSize;  // per pixel: cut nodes summed over its shading points / spp
+  std::vector<float> shadowRays;  // per pixel: shadow rays over its samples / samples
+  std::vector<uint8_t> aaFlagged;  // per pixel: 1 when adaptive antialiasing re-sampled it
   RenderStats stats;
   bool interrupted = false;
   std::vector<uint8_t> done;   // per pixel: 1 when rendered (an interrupted render is partial)
@@ -162,6 +196,16 @@ RenderResult render(const scene::Scene& scene, const lightcuts::LightEvaluator& 
 // 0 when the scene has no VPLs.
 double vplClampedFraction(const scene::Scene& scene, const RenderOptions& options, int points = 256,
                           uint64_t maxEvaluations = 2'000'000);
+
+// Per-pixel auxiliary outputs (AOVs) at the pixel centre's primary hit: the material's
+// diffuse colour (albedo, texture applied), the shading normal (world space) and the
+// distance along the camera ray (depth); a ray that hits nothing gives 0, 0 and +inf.
+struct PixelAovs {
+  std::vector<Color> albedo;
+  std::vector<Vec3> normal;
+  std::vector<float> depth;
+};
+PixelAovs primaryAovs(const scene::Scene& scene, const RenderOptions& options);
 
 // Radiance along one camera ray (exposed for tests).
 Color traceRay(const scene::Scene& scene, const lightcuts::LightEvaluator& evaluator, const scene::Ray& ray,

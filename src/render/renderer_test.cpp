@@ -19,6 +19,7 @@ std::unique_ptr<scene::Scene> sceneFrom(const std::string& text) {
 RenderResult renderBrute(const scene::Scene& s, int w, int h, int threads = 0, int spp = 1) {
   auto ev = lightcuts::makeBruteForce(s.lights());
   RenderOptions o;
+  o.aa = AntiAliasing::Off;  // checked at pixel centres (closed forms, per-pixel comparisons)
   o.width = w;
   o.height = h;
   o.threads = threads;

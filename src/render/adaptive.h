@@ -1,0 +1,44 @@
+// Adaptive antialiasing, the parts that do not trace: which pixels of a tile to re-sample
+// (their centre samples disagree with a neighbour's: RenderOptions::aa*, renderer.h) and
+// where the sub-samples go. The renderer traces them (renderer.cpp, adaptiveTile).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/math.h"
+#include "core/rng.h"
+#include "render/renderer.h"
+
+namespace lc::render {
+
+// What a pixel's centre ray saw.
+struct CentreSample {
+  int shape = -1;        // the shape hit, -1 for none
+  Vec3 n{0, 0, 0};       // its shading normal
+  float luminance = 0;   // the pixel's value, clamped to 1 as displayed (when known)
+  bool known = false;    // luminance is known (the pixel is in the tile)
+};
+
+// Whether two neighbouring centre samples disagree (an edge lies between them).
+bool disagree(const CentreSample& a, const CentreSample& b, const RenderOptions& o);
+
+// Flags for the w x h pixels of a tile, given their centre samples on a (w + 2) x (h + 2)
+// grid (the tile and a one-pixel ring around it, row-major; ring entries outside the image
+// have shape -2 and never disagree). A pixel is flagged when any of its 8 neighbours
+// disagrees with it.
+std::vector<uint8_t> flagPixels(const std::vector<CentreSample>& ring, int w, int h, const RenderOptions& o);
+
+// The side g of the stratified grid for aaSamples = g^2 - 1 sub-samples (0 when invalid).
+int aaGridSide(int aaSamples);
+
+// Sub-sample s (0 .. g^2 - 2) of a pixel: jittered in stratum s of the g x g grid, the
+// middle stratum (the centre sample's) skipped.
+Vec2 aaSubSamplePosition(int s, int g, Rng& rng);
+
+// The random stream of a pixel's sub-samples (distinct from its fixed-spp stream).
+inline uint64_t aaStream(int x, int y, int width, int height) {
+  return uint64_t(width) * uint64_t(height) + uint64_t(y) * uint64_t(width) + uint64_t(x);
+}
+
+}  // namespace lc::render

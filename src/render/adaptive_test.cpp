@@ -1,0 +1,184 @@
+// Adaptive antialiasing: which pixels are flagged, where sub-samples go, an edge's pixels
+// coming out as the area each side covers, and the reference pixels evaluating the same
+// sub-samples.
+#include "render/adaptive.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "io/ray_parser.h"
+#include "lightcuts/light_tree.h"
+
+namespace lc::render {
+namespace {
+
+std::unique_ptr<scene::Scene> sceneFrom(const std::string& text) {
+  io::SceneDesc d = io::parseRayString(text, "test.ray", "");
+  return scene::Scene::build(d);
+}
+
+CentreSample hitOn(int shape, Vec3 n, float lum) {
+  CentreSample c;
+  c.shape = shape;
+  c.n = n;
+  c.luminance = lum;
+  c.known = true;
+  return c;
+}
+
+TEST(AdaptiveFlags, ShapeNormalAndContrastEachFlagBothSides) {
+  RenderOptions o;
+  const Vec3 z(0, 0, 1);
+  EXPECT_FALSE(disagree(hitOn(1, z, 0.5f), hitOn(1, z, 0.52f), o));  // 4%: noise, not an edge
+  EXPECT_TRUE(disagree(hitOn(1, z, 0.5f), hitOn(2, z, 0.5f), o));    // another shape
+  EXPECT_TRUE(disagree(hitOn(1, z, 0.5f), CentreSample{}, o));       // the background
+  EXPECT_TRUE(disagree(hitOn(1, z, 0.5f), hitOn(1, normalize(Vec3(0, 1, 1)), 0.5f), o));  // 45 degrees
+  EXPECT_FALSE(disagree(hitOn(1, z, 0.5f), hitOn(1, normalize(Vec3(0, 0.2f, 1)), 0.5f), o));  // 11 degrees
+  EXPECT_TRUE(disagree(hitOn(1, z, 0.5f), hitOn(1, z, 0.3f), o));   // 40% contrast: a shadow edge
+  EXPECT_FALSE(disagree(hitOn(1, z, 0.5f), hitOn(1, z, 0.4f), o));  // 20%: below aaContrast (25%)
+  EXPECT_TRUE(disagree(hitOn(1, z, 2.0f), hitOn(1, z, 0.7f), o));   // compared as displayed: 1 vs 0.7
+  EXPECT_FALSE(disagree(hitOn(1, z, 5.0f), hitOn(1, z, 3.0f), o));  // both white on screen
+  EXPECT_FALSE(disagree(hitOn(1, z, 0.001f), hitOn(1, z, 0.002f), o));  // below the floor
+  CentreSample unknown = hitOn(1, z, 0.0f);
+  unknown.known = false;  // across a tile border: luminance not compared
+  EXPECT_FALSE(disagree(hitOn(1, z, 0.5f), unknown, o));
+  CentreSample outside;
+  outside.shape = -2;
+  EXPECT_FALSE(disagree(hitOn(1, z, 0.5f), outside, o));
+
+  // A 4 x 3 tile (6 x 5 with its ring) with a vertical edge between columns 1 and 2.
+  const int w = 4, h = 3;
+  std::vector<CentreSample> ring(size_t(w + 2) * size_t(h + 2));
+  for (int y = 0; y < h + 2; ++y)
+    for (int x = 0; x < w + 2; ++x) ring[size_t(y) * (w + 2) + x] = hitOn(x < 3 ? 1 : 2, z, 0.5f);
+  std::vector<uint8_t> f = flagPixels(ring, w, h, o);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) EXPECT_EQ(f[size_t(y) * w + x], x == 1 || x == 2) << x << "," << y;
+}
+
+TEST(AdaptiveSubSamples, OneInEachStratumButTheMiddle) {
+  for (int n : {8, 24, 48}) {
+    const int g = aaGridSide(n);
+    ASSERT_EQ(g * g - 1, n);
+    Rng rng(1, 7);
+    std::set<int> strata;
+    for (int s = 0; s < n; ++s) {
+      Vec2 u = aaSubSamplePosition(s, g, rng);
+      ASSERT_TRUE(u.x >= 0 && u.x < 1 && u.y >= 0 && u.y < 1);
+      strata.insert(int(u.y * float(g)) * g + int(u.x * float(g)));
+    }
+    EXPECT_EQ(int(strata.size()), n);
+    EXPECT_EQ(strata.count(g * g / 2), 0u);
+  }
+  EXPECT_EQ(aaGridSide(16), 0);
+  EXPECT_EQ(antiAliasingName(parseAntiAliasing("off")), std::string("off"));
+  EXPECT_EQ(parseAntiAliasing("adaptive"), AntiAliasing::Adaptive);
+  EXPECT_THROW(parseAntiAliasing("fxaa"), Error);
+  EXPECT_EQ(RenderOptions{}.aa, AntiAliasing::Adaptive);  // the default
+}
+
+// An emissive half-plane x < 0.2 seen head on, black beyond: a pixel's value is the share of
+// its area left of the edge.
+const char* kEdgeScene = R"(SBT-raytracer 1.0
+camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 90; }
+trimesh { points = ((-20, -20, 0), (0.2, -20, 0), (0.2, 20, 0), (-20, 20, 0)); faces = ((0, 1, 2), (0, 2, 3));
+  material = { emissive = (1, 1, 1); }; }
+)";
+
+TEST(AdaptiveRender, EdgePixelsAreTheirCoverageAndOthersTheirCentre) {
+  auto s = sceneFrom(kEdgeScene);
+  auto ev = lightcuts::makeBruteForce(s->lights());
+  RenderOptions o;
+  o.width = o.height = 16;
+  RenderOptions off = o;
+  off.aa = AntiAliasing::Off;
+  RenderResult a = render(*s, *ev, o), b = render(*s, *ev, off);
+  const scene::Camera& cam = s->camera();
+  auto worldX = [&](float sx) {
+    Vec3 d = cam.direction(sx, 0.5f);
+    return cam.eye.x + d.x * (-cam.eye.z / d.z);
+  };
+  int edgePixels = 0;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      float xa = worldX(float(x) / 16), xb = worldX(float(x + 1) / 16);
+      float cover = std::clamp((0.2f - std::min(xa, xb)) / std::fabs(xb - xa), 0.0f, 1.0f);
+      const size_t i = size_t(y) * 16 + size_t(x);
+      EXPECT_NEAR(a.image.pixels[i].x, cover, 0.12f) << x << "," << y;
+      if (!a.aaFlagged[i]) {
+        EXPECT_EQ(a.image.pixels[i], b.image.pixels[i]);
+      }
+      if (cover > 0.1f && cover < 0.9f) {
+        ++edgePixels;
+        EXPECT_TRUE(a.aaFlagged[i]);
+        EXPECT_GT(std::fabs(b.image.pixels[i].x - cover), 0.12f);  // one centre sample is 0 or 1
+      }
+    }
+  EXPECT_EQ(edgePixels, 16);  // one column
+  EXPECT_EQ(a.stats.aaPixels, 32u);  // the two columns either side of the edge
+  EXPECT_EQ(a.stats.aaSubSamples, 32u * 8u);
+  EXPECT_EQ(a.stats.primaryRays, 256u + 32u * 8u);
+  // With --spp 2, every pixel gets two samples and no more.
+  RenderOptions fixed = o;
+  fixed.spp = 2;
+  RenderResult c = render(*s, *ev, fixed);
+  EXPECT_EQ(c.stats.aaPixels, 0u);
+  EXPECT_EQ(c.stats.primaryRays, 512u);
+}
+
+// A square shadowing a diffuse plane: lightcuts with a zero threshold is brute force, so
+// the reference pixels measure no error, the flagged ones included, only if they evaluate
+// the same sub-samples as the image.
+TEST(AdaptiveRender, ReferencePixelsEvaluateTheSameSubSamples) {
+  auto s = sceneFrom(R"(SBT-raytracer 1.0
+camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 60; }
+point_light { position = (0.3, 0.2, 3); colour = (1, 1, 1); }
+point_light { position = (-0.4, 0.1, 3); colour = (0.5, 0.5, 1); }
+scale(10, square { material = { diffuse = (0.7, 0.7, 0.7); }; })
+translate(0, 0, 1, scale(1.2, square { material = { diffuse = (0.9, 0.2, 0.2); }; }))
+)");
+  lightcuts::LightForest forest = lightcuts::buildLightForest(s->lights());
+  lightcuts::CutOptions co;
+  co.errorRatio = 0;
+  auto lc = lightcuts::makeLightcuts(s->lights(), forest, co);
+  RenderOptions o;
+  o.width = o.height = 32;
+  o.referencePixels = 32 * 32;
+  RenderResult r = render(*s, *lc, o);
+  EXPECT_GT(r.stats.aaPixels, 50u);
+  EXPECT_EQ(r.stats.reference.pixels, 32 * 32);
+  EXPECT_LT(r.stats.reference.maxRelativeError, 1e-4);
+  // The image is the same at one and two threads.
+  o.referencePixels = 0;
+  o.threads = 1;
+  RenderResult one = render(*s, *lc, o);
+  o.threads = 2;
+  RenderResult two = render(*s, *lc, o);
+  for (size_t i = 0; i < one.image.pixels.size(); ++i) ASSERT_EQ(one.image.pixels[i], two.image.pixels[i]) << i;
+}
+
+TEST(Aovs, AlbedoNormalAndDepthOfAPlaneSeenHeadOn) {
+  auto s = sceneFrom(R"(SBT-raytracer 1.0
+camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 60; }
+scale(10, square { material = { diffuse = (0.5, 0.6, 0.7); }; })
+)");
+  RenderOptions o;
+  o.width = 9;
+  o.height = 7;
+  PixelAovs a = primaryAovs(*s, o);
+  const scene::Camera& cam = s->camera();
+  for (int y = 0; y < o.height; ++y)
+    for (int x = 0; x < o.width; ++x) {
+      const size_t i = size_t(y) * size_t(o.width) + size_t(x);
+      Vec3 d = normalize(cam.direction((float(x) + 0.5f) / float(o.width), (float(y) + 0.5f) / float(o.height)));
+      EXPECT_NEAR(a.depth[i], 5.0f / -d.z, 1e-4f);
+      EXPECT_NEAR(a.normal[i].z, 1.0f, 1e-6f);
+      EXPECT_EQ(a.albedo[i], Color(0.5f, 0.6f, 0.7f));
+    }
+}
+
+}  // namespace
+}  // namespace lc::render
