@@ -462,6 +462,12 @@ std::vector<Row> catalogue() {
                      {"--max-nesting", "2"}));
   rows.push_back(ray("limit_image_pixels", "sphere {}", "an image of 100x100 exceeds --max-image-pixels (1000)",
                      {"--width", "100", "--height", "100", "--max-image-pixels", "1000"}));
+  rows.push_back(ray("aov_needs_exr", "sphere {}",
+                     "--aov needs an .exr output (its layers are extra EXR channels); 'out.png' is .png",
+                     {"--aov", "depth"}));
+  rows.push_back(ray("aov_unknown", "sphere {}",
+                     "--aov: unknown output 'dpth\\x1b' (use albedo, normal, depth, cut, shadow_rays, comma-separated)",
+                     {"--aov", "albedo,dpth\x1b"}));
   rows.push_back(ray("aspect_ratio_too_wide", "camera { aspectratio = 3e9; }",
                      "aspectratio 3000000000 makes the image 3000000000x1: more than 65536 pixels wide (give both --width and --height)",
                      {"--height", "1"}));

@@ -119,9 +119,9 @@ std::vector<std::string> parseAovs(const std::string& list) {
     bool known = false;
     for (const AovKind& k : kAovs) known = known || name == k.name;
     if (!known)
-      throw Error(fmt::format("--aov: unknown output '{}' (use albedo, normal, depth, cut, shadow_rays, "
+      throw Error(fmt::format("--aov: unknown output {} (use albedo, normal, depth, cut, shadow_rays, "
                               "comma-separated)",
-                              name));
+                              quoteInput(name)));
     if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
     if (comma == std::string::npos) break;
     start = comma + 1;
