@@ -1,8 +1,8 @@
 // The CLI fuzz target's entry point (fuzz/cli_fuzz.cpp), shared with the regression test
 // (src/app/fuzz_regression_test.cpp). The input is split at newlines into at most 32
 // arguments after "lightcuts"; the whole CLI as main() builds it (every command, option,
-// validator and option callback) parses them, with the commands' actions removed so that
-// nothing renders or writes. CLI::ParseError (main() turns it into a usage message) and
+// validator and option callback) parses them, with app::parseOnly() set so that the
+// commands do not run: nothing renders or writes. CLI::ParseError (main() turns it into a usage message) and
 // lc::Error are clean refusals; anything else is a finding.
 #pragma once
 
@@ -35,7 +35,11 @@ inline void parseArgs(const uint8_t* data, size_t size) {
 
   CLI::App app{"lightcuts"};
   app::addCommands(app);
-  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) sub->callback(std::function<void()>());
+  // Not by replacing the commands' callbacks: they own the state their options write to.
+  struct ParseOnly {
+    ParseOnly() { app::parseOnly() = true; }
+    ~ParseOnly() { app::parseOnly() = false; }
+  } parseOnly;
   try {
     app.parse(int(argv.size()), argv.data());
   } catch (const CLI::ParseError&) {

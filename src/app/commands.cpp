@@ -8,6 +8,11 @@ int& exitStatus() {
   return status;
 }
 
+bool& parseOnly() {
+  static bool only = false;
+  return only;
+}
+
 std::string& commandLine() {
   static std::string line;
   return line;

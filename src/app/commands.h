@@ -15,6 +15,10 @@ void addSkyCommand(CLI::App& app);
 // Every command above, and the top level's rules (main.cpp and the CLI fuzz target).
 void addCommands(CLI::App& app);
 
+// When set, the commands parse and check their arguments but do not run (the CLI fuzz
+// target): their options stay bound to state their callbacks own.
+bool& parseOnly();
+
 // Exit status of the subcommand that ran (set by its callback).
 int& exitStatus();
 

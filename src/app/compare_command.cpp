@@ -78,7 +78,9 @@ void addCompareCommand(CLI::App& app) {
                 fmt::format("Relative error counted by fraction_over_threshold (also written as fraction_over_2pct); "
                             "default {:g}", d.threshold))
       ->check(CLI::Range(0.0, 1e6));
-  c->callback([a] { exitStatus() = runCompare(*a); });
+  c->callback([a] {
+    if (!parseOnly()) exitStatus() = runCompare(*a);
+  });
 }
 
 }  // namespace lc::app

@@ -84,7 +84,9 @@ void addInfoCommand(CLI::App& app) {
   c->add_option("scene", a->scene, "Scene file (.ray or .obj)")->required();
   c->add_flag("--json", a->json, "Print JSON");
   addSceneOptions(*c, a->load);
-  c->callback([a] { exitStatus() = runInfo(*a); });
+  c->callback([a] {
+    if (!parseOnly()) exitStatus() = runInfo(*a);
+  });
 }
 
 }  // namespace lc::app

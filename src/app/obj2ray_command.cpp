@@ -24,6 +24,7 @@ void addObj2RayCommand(CLI::App& app) {
                 "Output .ray file (default: the input with its extension replaced by .ray, in the input's folder: "
                 "model.obj -> model.ray)");
   c->callback([in, out] {
+    if (parseOnly()) return;
     if (out->empty()) {
       *out = defaultRayOutput(*in);
       // A default that would overwrite the input (IN is already .ray) is refused, not written.

@@ -774,7 +774,9 @@ void addRenderCommand(CLI::App& app) {
       ->check(CLI::IsMember({"auto"}) | CLI::Range(0, 1 << 16))
       ->group(recon);
   addSceneOptions(*c, a->load);
-  c->callback([a] { exitStatus() = runRender(*a); });
+  c->callback([a] {
+    if (!parseOnly()) exitStatus() = runRender(*a);
+  });
 }
 
 }  // namespace lc::app

@@ -72,7 +72,9 @@ void addSkyCommand(CLI::App& app) {
   c->add_option("--width", a->width, "Map width; default 256")->check(CLI::Range(1, 16384));
   c->add_option("--height", a->height, "Map height; default 128")->check(CLI::Range(1, 8192));
   c->add_flag("--sun", a->sun, "Put the sun's power into the pixel at its centre");
-  c->callback([a] { exitStatus() = runSky(*a); });
+  c->callback([a] {
+    if (!parseOnly()) exitStatus() = runSky(*a);
+  });
 }
 
 }  // namespace lc::app
