@@ -493,8 +493,8 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
     // Thread-seconds in shadow rays (estimated from a timed sample) and in light evaluation
     // as a whole; their ratio is the share the rays leave to the cut's own work.
     j["time_shadow_rays_s"] = es.shadowRaySeconds();
-    j["time_lighting_s"] = double(es.lightingNanos) * 1e-9;
-    j["shadow_ray_share"] = es.lightingNanos > 0 ? es.shadowRaySeconds() / (double(es.lightingNanos) * 1e-9) : 0.0;
+    j["time_lighting_s"] = es.lightingSeconds();
+    j["shadow_ray_share"] = es.lightingSeconds() > 0 ? es.shadowRaySeconds() / es.lightingSeconds() : 0.0;
     j["rays_per_second"] = rr.stats.seconds > 0 ? double(allRays) / rr.stats.seconds : 0;
     j["shading_points"] = es.shadingPoints;
     j["lights"] = lightCountsJson(scene.lights());

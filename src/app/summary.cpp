@@ -52,6 +52,8 @@ void forEachEvalCounter(S& s, F&& f) {
   f("traced_rays", s.tracedRays);
   f("timed_rays", s.timedRays);
   f("timed_ray_nanos", s.timedRayNanos);
+  f("lit_points", s.litPoints);
+  f("timed_points", s.timedPoints);
   f("lighting_nanos", s.lightingNanos);
 }
 }  // namespace

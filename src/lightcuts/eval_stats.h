@@ -28,7 +28,13 @@ struct EvalStats {
   uint64_t tracedRays = 0;           // rays through the Visibility (shadow and probe rays)
   uint64_t timedRays = 0;            // a random sample of them, timed
   uint64_t timedRayNanos = 0;        // their summed time
-  uint64_t lightingNanos = 0;        // thread CPU time in light evaluation, rays included
+  uint64_t litPoints = 0;            // shading points whose light was evaluated
+  uint64_t timedPoints = 0;          // a random sample of them, timed
+  uint64_t lightingNanos = 0;        // their thread CPU time in light evaluation, rays included
+  // The time in light evaluation, estimated from its sample.
+  double lightingSeconds() const {
+    return timedPoints ? double(lightingNanos) * 1e-9 * double(litPoints) / double(timedPoints) : 0.0;
+  }
   // The time in shadow rays, estimated from the sample.
   double shadowRaySeconds() const {
     return timedRays ? double(timedRayNanos) * 1e-9 * double(tracedRays) / double(timedRays) : 0.0;
@@ -57,6 +63,8 @@ struct EvalStats {
     tracedRays += o.tracedRays;
     timedRays += o.timedRays;
     timedRayNanos += o.timedRayNanos;
+    litPoints += o.litPoints;
+    timedPoints += o.timedPoints;
     lightingNanos += o.lightingNanos;
     for (size_t i = 0; i < cutHistogram.size(); ++i) cutHistogram[i] += o.cutHistogram[i];
   }
