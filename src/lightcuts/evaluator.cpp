@@ -140,6 +140,9 @@ class Lightcuts final : public LightEvaluator {
     float spread;    // error scale used by the total criterion (see below)
     float lower, upper;   // luminance of the unshadowed bounds (first-order candidates)
     ShadowResult shadow;  // what the representative's shadow ray found
+    // The node's children, representative and light count, copied from its LightNode so
+    // that refining it reads only its children's cache lines, not its own again.
+    uint32_t left, rep, lights;
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
     bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
   };
@@ -238,6 +241,10 @@ class Lightcuts final : public LightEvaluator {
     const bool firstOrder = opt_.estimator == Estimator::FirstOrder;
     const bool probes = opt_.visibilityProbes;
 
+    // Inner nodes pushed by the last refinement: their children's lights are prefetched
+    // after the next one (below).
+    std::pair<uint32_t, uint32_t> pending[2], fresh[2];
+    uint32_t pendingCount = 0, freshCount = 0;
     // Adds a node to the cut: its estimate to the total, and to the heap unless exact.
     auto record1 = [&](uint32_t t, uint32_t ni, CutVisibility found, bool fo, float factor = 1) {
       recorded.emplace_back(uint64_t(t) << 32 | CutRecord::pack(forest_.trees[t].preorder[ni], found, fo), factor);
@@ -270,6 +277,7 @@ class Lightcuts final : public LightEvaluator {
         // A node in the heap may be refined next: fetch its children while we work.
         __builtin_prefetch(&tree.nodes[n.left]);
         __builtin_prefetch(&tree.nodes[n.left + 1]);
+        if (freshCount < 2) fresh[freshCount++] = {t, n.left};
         const float lo = luminance(lower);
         float spread = visible && !boundary ? std::max(0.0f, b - lo) : b;
         // Where the contribution is smooth over the cluster and its representative is
@@ -284,7 +292,7 @@ class Lightcuts final : public LightEvaluator {
         const bool scaled = rss && fo && !boundary;
         (scaled ? sumScaled : sumSq) += double(spread) * spread;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
-        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, fo, scaled});
+        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, n.left, n.rep, n.lights, fo, scaled});
       } else if (record) {
         record1(t, ni, found, false);
       }
@@ -319,7 +327,7 @@ class Lightcuts final : public LightEvaluator {
       sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
       const LightTree& tree = forest_.trees[cn.tree];
       const LightGroup& g = lights_.groups[tree.group];
-      if (probes && cn.shadow.blocker >= 0 && tree.lightCount(cn.node) >= kProbeMinLights &&
+      if (probes && cn.shadow.blocker >= 0 && cn.lights >= kProbeMinLights &&
           hiddenCluster(tree.nodes[cn.node], tree.type, sp, cn.shadow, vis, stats)) {
         // Its representative is hidden, and so is the whole cluster: it stays in the cut,
         // exactly 0, instead of being refined down to its lights.
@@ -329,15 +337,14 @@ class Lightcuts final : public LightEvaluator {
       }
       total -= cn.estimate;
       --cutSize;
-      const LightNode& n = tree.nodes[cn.node];
       ShadowResult shadows[2];
       Color units[2];
       for (uint32_t k = 0; k < 2; ++k) {
-        const uint32_t c = n.left + k, rep = tree.nodes[c].rep;
+        const uint32_t c = cn.left + k, rep = tree.nodes[c].rep;
         // The child that shares the parent's representative reuses its shadow ray.
         // Only clusters that may be probed need to know what hid their representative.
         shadows[k] = cn.shadow;
-        units[k] = rep == n.rep ? cn.unit
+        units[k] = rep == cn.rep ? cn.unit
                                 : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, shadows[k],
                                                probes && tree.lightCount(c) >= kProbeMinLights);
       }
@@ -349,10 +356,34 @@ class Lightcuts final : public LightEvaluator {
         ++refinedTested;
         refinedSplit += boundary;
       }
-      for (uint32_t k = 0; k < 2; ++k) addNode(cn.tree, n.left + k, units[k], shadows[k], boundary);
+      for (uint32_t k = 0; k < 2; ++k) addNode(cn.tree, cn.left + k, units[k], shadows[k], boundary);
+      // A second stage of prefetching: the children of the nodes pushed one refinement ago
+      // have arrived (addNode fetched them); fetch their representatives' lights, which the
+      // next refinement's shadow ray reads (a miss on the light was half of
+      // lightContribution's time, perf on 100k point lights).
+      for (uint32_t k = 0; k < pendingCount; ++k) {
+        const LightNode* kids = &forest_.trees[pending[k].first].nodes[pending[k].second];
+        __builtin_prefetch(&lights_.lights[kids[0].rep]);
+        __builtin_prefetch(&lights_.lights[kids[1].rep]);
+      }
+      pendingCount = freshCount;
+      for (uint32_t k = 0; k < freshCount; ++k) pending[k] = fresh[k];
+      freshCount = 0;
     }
     // The first-order estimates of the clusters left in the cut, kept within their bounds;
-    // their ratio to the representative's is what a reconstruction borrows.
+    // their ratio to the representative's is what a reconstruction borrows. Their nodes,
+    // moments and lights are fetched first, all at once: read one by one, each was a cache
+    // miss (perf: 13% of the cut loop on 100k point lights).
+    if (firstOrder) {
+      for (uint64_t key : heap) {
+        const CutNode& cn = nodes[uint32_t(key)];
+        if (!cn.firstOrder) continue;
+        const LightTree& tree = forest_.trees[cn.tree];
+        __builtin_prefetch(&tree.nodes[cn.node]);
+        __builtin_prefetch(&tree.moments[(cn.left - 1) / 2]);
+        __builtin_prefetch(&lights_.lights[cn.rep]);
+      }
+    }
     for (uint64_t key : heap) {
       const CutNode& cn = nodes[uint32_t(key)];
       float factor = 1;
@@ -371,8 +402,9 @@ class Lightcuts final : public LightEvaluator {
       } else if (cn.firstOrder) {
         const LightTree& tree = forest_.trees[cn.tree];
         const LightNode& n = tree.nodes[cn.node];
-        Color fo = vmax(firstOrderUnit(lights_.lights[n.rep], lights_.groups[tree.group], sp, tree.momentsOf(lights_, cn.node),
-                                       cn.unit) * n.intensity, Color(0));
+        // A first-order node is never a leaf: its moments are stored.
+        Color fo = vmax(firstOrderUnit(lights_.lights[cn.rep], lights_.groups[tree.group], sp,
+                                       tree.moments[(cn.left - 1) / 2], cn.unit) * n.intensity, Color(0));
         float raw = luminance(cn.estimate), lf = luminance(fo);
         if (raw > 0 && lf > 0) {
           float kept = std::clamp(lf, cn.lower, cn.upper);

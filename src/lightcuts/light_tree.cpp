@@ -125,7 +125,7 @@ void setMeans(NodeMoments& m, const MomentSums& s) {
 // below `top` and returns top's sums. `known(i, sums)` may supply a subtree's sums.
 template <class Known>
 MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, uint32_t top, const Known& known) {
-  std::vector<NodeMoments>& m = tree.moments;
+  BigVector<NodeMoments>& m = tree.moments;
   std::vector<std::pair<uint32_t, bool>> stack{{top, false}};  // node, children done
   std::vector<MomentSums> done;  // the finished subtrees whose parent is not
   while (!stack.empty()) {
@@ -173,7 +173,7 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
   // long chain of merges adds up). A subtree of zero weight takes the plain mean. Each
   // node's sums are its left child's plus its right child's, so the subtrees below the
   // top levels are summed in parallel to the same values. Memory: the tree's depth.
-  std::vector<NodeMoments>& m = tree.moments;
+  BigVector<NodeMoments>& m = tree.moments;
   m.assign(tree.nodes.size() / 2, NodeMoments{});  // one per inner node
   if (tree.nodes.empty()) return;
   if (tree.preorder.size() != tree.nodes.size()) computePreorder(tree);

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "core/huge_pages.h"
 #include "core/math.h"
 #include "core/progress.h"
 #include "core/light.h"
@@ -59,18 +60,18 @@ struct NodeMoments {
 struct LightTree {
   LightType type = LightType::Omni;
   uint16_t group = 0;
-  std::vector<LightNode> nodes;  // nodes[0] is the root
+  BigVector<LightNode> nodes;  // nodes[0] is the root
   // Parallel to nodes when filled: the seed builder fills it; agglomerative trees leave it
   // empty (unless TreeBuildOptions::courseData) and makeCourseCuts computes it on demand.
   std::vector<CourseNodeData> course;
   // Per inner node, at (left - 1) / 2: sibling pairs sit at nodes 1-2, 3-4, ..., so that is
   // each inner node's own slot (n - 1 of them). A leaf's moments are its light's
   // (momentsOf); storing them would repeat the light (24 bytes per light).
-  std::vector<NodeMoments> moments;
+  BigVector<NodeMoments> moments;
   // Parallel to nodes: each node's position in a depth-first walk that visits the left
   // child (n.left) before the right one, so a subtree is a contiguous range. Reconstruction
   // cuts (reconstruction.h) compare cuts of different points by it.
-  std::vector<uint32_t> preorder;
+  BigVector<uint32_t> preorder;
 
   // Node i's moments: stored for inner nodes, made from the light for a leaf.
   NodeMoments momentsOf(const LightSet& lights, uint32_t i) const {
