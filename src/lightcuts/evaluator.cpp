@@ -298,6 +298,7 @@ class Lightcuts final : public LightEvaluator {
       }
     };
 
+    uint32_t cutRoots = 0;
     for (uint32_t t = 0; t < forest_.trees.size(); ++t) {
       const LightTree& tree = forest_.trees[t];
       if (tree.nodes.empty()) continue;
@@ -306,11 +307,17 @@ class Lightcuts final : public LightEvaluator {
       Color unit = shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats, shadow,
                                 probes && tree.lightCount(0) >= kProbeMinLights);
       addNode(t, 0, unit, shadow);
+      ++cutRoots;
     }
+    // The budget grows by one node per tree after the first: a forest of more trees than
+    // --max-cut (a scene whose lights all differ in attenuation or cone, one tree each)
+    // still refines its large trees. Stopping at the roots left a 15,000-light tree as one representative (errors of
+    // 1,000% on a scene of 15,000 spots with their own cone angles).
+    const uint32_t maxCut = uint32_t(opt_.maxCut) + std::max(cutRoots, 1u) - 1;
     const float eps = opt_.errorRatio;
     const double rssFactor2 = kTotalFactor * kTotalFactor;
     while (!heap.empty()) {
-      if (cutSize >= uint32_t(opt_.maxCut)) break;
+      if (cutSize >= maxCut) break;
       // Weber's law has a floor: below errorFloor (set by the renderer from the image's
       // mean) the cut is held to an absolute error, as the image metric's floor does.
       float limit = float(eps * std::max(luminance(total), double(sp.errorFloor)));
@@ -540,6 +547,8 @@ class CourseCuts final : public LightEvaluator {
     uint32_t cutSize = 0;
     for (uint32_t t = 0; t < forest_.trees.size(); ++t)
       if (!forest_.trees[t].nodes.empty()) stack.emplace_back(t, 0u);
+    // As for lightcuts: one more node per tree after the first.
+    const size_t maxCut = size_t(opt_.maxCut) + std::max<size_t>(stack.size(), 1) - 1;
     while (!stack.empty()) {
       auto [t, ni] = stack.back();
       stack.pop_back();
@@ -549,7 +558,7 @@ class CourseCuts final : public LightEvaluator {
       if (!n.isLeaf()) {
         const CourseNodeData& sd = seed_[t][ni];
         float dist = tree.type == LightType::Directional ? 1.0f : length(sp.p - sd.position);
-        if (sd.error > opt_.errorRatio * dist && cutSize + stack.size() + 2 <= uint32_t(opt_.maxCut)) {
+        if (sd.error > opt_.errorRatio * dist && cutSize + stack.size() + 2 <= maxCut) {
           stack.emplace_back(t, n.left);
           stack.emplace_back(t, n.left + 1);
           continue;

@@ -59,7 +59,7 @@ constexpr float kCourseCutsDefaultError = 0.25f;
 
 struct CutOptions {
   float errorRatio = 0.02f;  // --error: relative error threshold
-  int maxCut = 4000;         // --max-cut: most nodes in one cut
+  int maxCut = 4000;         // --max-cut: most nodes in one cut, plus one per tree after the first
   CutCriterion criterion = CutCriterion::Total;
   Estimator estimator = Estimator::FirstOrder;  // --estimator (estimate.h)
   // --visibility-probes: before a cluster of 16 lights or more whose representative is

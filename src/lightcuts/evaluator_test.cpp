@@ -271,7 +271,6 @@ TEST(Methods, ParseNames) {
   EXPECT_EQ(parseMethod("seed"), Method::Course);
   EXPECT_THROW(parseMethod("fast"), Error);
 }
-
 }  // namespace
 }  // namespace lc::lightcuts
 
@@ -362,7 +361,6 @@ TEST(VisibilityProbes, ProvenHiddenClustersAreExact) {
     EXPECT_LT(st.cutNodes, sb.cutNodes) << lightTypeName(type);
   }
 }
-
 }  // namespace
 }  // namespace lc::lightcuts
 
@@ -399,6 +397,44 @@ TEST(Precision, BruteForceOverMillionsOfDimLightsIsExact) {
   }
   EXPECT_EQ(r.cutSize, kDim + 1);
 }
+
+// A forest of more trees than --max-cut (every spot light with its own cone is a tree of
+// its own) must still refine its large tree: each tree after the first adds one node to the
+// budget.
+// Stopping at the roots left 1,000 point lights as one representative.
+TEST(MaxCut, CountsRefinementsBeyondTheRoots) {
+  LightSet s = cloud(1000, LightType::Omni, 5);
+  const uint32_t spots = 300;
+  for (uint32_t i = 0; i < spots; ++i) {
+    LightGroup g;
+    g.falloff.cosCutoff = std::cos(0.3f + 0.002f * float(i));  // a group, so a tree, per spot
+    s.groups.push_back(g);
+    Light l;
+    l.type = LightType::Spot;
+    l.group = uint16_t(s.groups.size() - 1);
+    l.position = Vec3(float(i) * 0.01f - 2, 3, 0);
+    l.direction = Vec3(0, -1, 0);
+    l.intensity = Color(0.0001f);
+    s.lights.push_back(l);
+  }
+  LightForest f = buildLightForest(s);
+  ASSERT_EQ(f.trees.size(), spots + 1);
+  auto bf = makeBruteForce(s);
+  CutOptions o;
+  o.maxCut = 200;  // fewer than the trees
+  auto lcut = makeLightcuts(s, f, o);
+  Unoccluded vis;
+  for (int i = 0; i < 10; ++i) {
+    ShadingPoint sp = point(Vec3(float(i) * 0.4f - 2, 0, 0.3f * float(i) - 1.5f));
+    EvalStats st;
+    EvalResult got = lcut->evaluate(sp, vis, st);
+    EXPECT_GT(got.cutSize, spots + 1) << "no refinement at point " << i;
+    EXPECT_LE(got.cutSize, spots + 200u);
+    Color want = bf->evaluate(sp, vis, st).radiance;
+    EXPECT_NEAR(luminance(got.radiance), luminance(want), 0.03f * luminance(want)) << "point " << i;
+  }
+}
+
 
 }  // namespace
 }  // namespace lc::lightcuts
