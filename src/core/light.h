@@ -14,8 +14,13 @@
 #pragma once
 
 #include <cmath>
+#include <algorithm>
 #include <cstdint>
+#include <cstring>
+#include <iterator>
+#include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "core/math.h"
@@ -107,6 +112,50 @@ struct LightGroup {
   }
 };
 
+// A group whose attenuation and falloff are at least those of both a and b at every
+// distance and angle (each is non-increasing in its coefficients, cone cosines and
+// exponent): what bounds a cluster that mixes the two. Both must agree on diffuseOnly and
+// isVpl. Not a lower bound of either.
+inline LightGroup upperEnvelope(const LightGroup& a, const LightGroup& b) {
+  LightGroup e = a;
+  e.atten.constant = std::min(a.atten.constant, b.atten.constant);
+  e.atten.linear = std::min(a.atten.linear, b.atten.linear);
+  e.atten.quadratic = std::min(a.atten.quadratic, b.atten.quadratic);
+  e.atten.maxDistance = std::max(a.atten.maxDistance, b.atten.maxDistance);
+  e.falloff.exponent = std::min(a.falloff.exponent, b.falloff.exponent);
+  e.falloff.cosCutoff = std::min(a.falloff.cosCutoff, b.falloff.cosCutoff);
+  // The smooth edge (cosOuter > -2) multiplies by a smoothstep that grows as either cosine
+  // falls; a group without one multiplies by 1, so the envelope has none then.
+  if (a.falloff.cosOuter <= -2 || b.falloff.cosOuter <= -2) {
+    e.falloff.cosOuter = e.falloff.cosInner = -2;
+  } else {
+    e.falloff.cosOuter = std::min(a.falloff.cosOuter, b.falloff.cosOuter);
+    e.falloff.cosInner = std::min(a.falloff.cosInner, b.falloff.cosInner);
+  }
+  return e;
+}
+
+// The other side: a group at most a's and b's at every distance and angle, what bounds a
+// mixed cluster from below.
+inline LightGroup lowerEnvelope(const LightGroup& a, const LightGroup& b) {
+  LightGroup e = a;
+  e.atten.constant = std::max(a.atten.constant, b.atten.constant);
+  e.atten.linear = std::max(a.atten.linear, b.atten.linear);
+  e.atten.quadratic = std::max(a.atten.quadratic, b.atten.quadratic);
+  e.atten.maxDistance = std::min(a.atten.maxDistance, b.atten.maxDistance);
+  e.falloff.exponent = std::max(a.falloff.exponent, b.falloff.exponent);
+  e.falloff.cosCutoff = std::max(a.falloff.cosCutoff, b.falloff.cosCutoff);
+  // A group without a smooth edge multiplies by 1, above any edge's smoothstep.
+  if (a.falloff.cosOuter <= -2) {
+    e.falloff.cosOuter = b.falloff.cosOuter;
+    e.falloff.cosInner = b.falloff.cosInner;
+  } else if (b.falloff.cosOuter > -2) {
+    e.falloff.cosOuter = std::max(a.falloff.cosOuter, b.falloff.cosOuter);
+    e.falloff.cosInner = std::max(a.falloff.cosInner, b.falloff.cosInner);
+  }
+  return e;
+}
+
 struct Light {
   Vec3 position;    // unused for directional lights
   Vec3 direction;   // oriented: unit surface normal; spot: unit axis; directional: unit travel direction
@@ -120,13 +169,28 @@ struct Light {
 struct LightSet {
   std::vector<Light> lights;
   std::vector<LightGroup> groups;
+  static constexpr size_t kMaxGroups = 65535;  // Light::group is 16 bits
 
-  // The index of an equal group, added when new.
+  // The index of an equal group, added when new (in constant time: a scene may give each
+  // of its 50,000 spots a cone of its own). Throws past kMaxGroups distinct groups; callers
+  // that know a file position check hasRoomFor first.
   uint16_t groupFor(const LightGroup& g) {
-    for (size_t i = 0; i < groups.size(); ++i)
-      if (groups[i] == g) return uint16_t(i);
-    groups.push_back(g);
-    return uint16_t(groups.size() - 1);
+    syncIndex();
+    auto [it, added] = index_.try_emplace(keyOf(g), uint16_t(groups.size()));
+    if (added) {
+      if (groups.size() >= kMaxGroups) {
+        index_.erase(it);
+        throw std::length_error("more than 65535 distinct light groups (attenuations, spot cones)");
+      }
+      groups.push_back(g);
+      indexed_ = groups.size();
+    }
+    return it->second;
+  }
+  // Whether groupFor(g) can return without throwing.
+  bool hasRoomFor(const LightGroup& g) {
+    syncIndex();
+    return groups.size() < kMaxGroups || index_.count(keyOf(g)) != 0;
   }
   size_t countOf(LightType t) const {
     size_t n = 0;
@@ -134,6 +198,31 @@ struct LightSet {
     return n;
   }
   size_t size() const { return lights.size(); }
+
+ private:
+  // The group's fields as bytes (+0 for -0, so that equal floats give equal keys).
+  static std::string keyOf(const LightGroup& g) {
+    const float f[] = {g.atten.constant, g.atten.linear, g.atten.quadratic, g.atten.maxDistance,
+                       g.falloff.exponent, g.falloff.cosCutoff, g.falloff.cosOuter, g.falloff.cosInner};
+    std::string k(sizeof f + 2, '\0');
+    for (size_t i = 0; i < std::size(f); ++i) {
+      float v = f[i] == 0 ? 0.0f : f[i];
+      std::memcpy(&k[i * sizeof(float)], &v, sizeof v);
+    }
+    k[sizeof f] = char(g.diffuseOnly);
+    k[sizeof f + 1] = char(g.isVpl);
+    return k;
+  }
+  // Groups may be appended directly (tests, loaders): index the ones not seen yet.
+  void syncIndex() {
+    if (indexed_ > groups.size()) {
+      index_.clear();
+      indexed_ = 0;
+    }
+    for (; indexed_ < groups.size(); ++indexed_) index_.try_emplace(keyOf(groups[indexed_]), uint16_t(indexed_));
+  }
+  std::unordered_map<std::string, uint16_t> index_;
+  size_t indexed_ = 0;
 };
 
 }  // namespace lc

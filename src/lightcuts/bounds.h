@@ -135,8 +135,12 @@ inline CosRange unitCosBounds(const RotatedBox& b, const Vec3& target, const Lig
 // bounded away from 0 (no clamp at the horizon) and no corner of the attenuation's clamp
 // between the nearest and farthest light. Only then is the first-order estimate
 // (estimate.h) valid.
+// `low`: the group the lower bound uses when it differs (a tree that mixes groups passes
+// their lower envelope, LightTree::boundLow); the contribution is then not called smooth.
 inline Color clusterBounds(const LightNode& node, LightType type, const LightGroup& g, const ShadingPoint& sp,
-                           const BoundFrames& fr, Color* lower, bool* smooth = nullptr) {
+                           const BoundFrames& fr, Color* lower, bool* smooth = nullptr,
+                           const LightGroup* low = nullptr) {
+  const LightGroup& gl = low ? *low : g;
   // Cosine bounds get a little slack so float rounding in the exact evaluation can never
   // exceed them (steep spot falloffs and high Phong exponents amplify it).
   constexpr float kSlack = 2e-5f;
@@ -173,7 +177,7 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
   Color mLo = sp.kd * cNLo;
   // Smooth: the first-order estimate applies (directional: its gradient is over the
   // directions, estimate.h).
-  bool sm = lower && cNLo > 0 &&
+  bool sm = lower && !low && cNLo > 0 &&
             (type == LightType::Omni || type == LightType::Oriented || directional);
   if (specular) {
     RotatedBox br(fr.r, c, h);
@@ -192,7 +196,7 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
   float gUp = 1, gLo = 1;
   if (type != LightType::Directional) {
     gUp = g.atten(dMin);
-    if (lower) gLo = g.atten(dMax);
+    if (lower) gLo = gl.atten(dMax);
     sm = sm && gLo > 0 && !g.atten.kinkBetween(dMin, dMax);
     if (type == LightType::Oriented || type == LightType::Spot) {
       // The light's cosine is between its axis a and the direction from a light to the
@@ -215,7 +219,7 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
       if (lower) {
         // 0 means "may be 90 degrees or more", not a cosine: no lower bound then.
         float cLo = dMax > 0 ? coneNarrow(std::max(0.0f, (pc - ph) / dMax), node.cosHalfAngle, sinHalfAngle) : 0.0f;
-        gLo *= cLo <= 0 ? 0.0f : (type == LightType::Oriented ? cLo : g.falloff(cLo));
+        gLo *= cLo <= 0 ? 0.0f : (type == LightType::Oriented ? cLo : gl.falloff(cLo));
         sm = sm && cLo > 0;
       }
     }

@@ -262,7 +262,6 @@ class Lightcuts final : public LightEvaluator {
         return;
       }
       ++stats.boundsEvaluated;
-      const LightGroup& g = lights_.groups[tree.group];
       // The total criterion adds up how far each estimate may be off: a cluster whose
       // representative is visible (and whose sibling's was: not on a shadow boundary,
       // `boundary`) is assumed unoccluded, so its estimate is within the upper minus the
@@ -271,7 +270,9 @@ class Lightcuts final : public LightEvaluator {
       bool visible = (rss || firstOrder) && !isBlack(unit);
       Color lower;
       bool smooth = false;
-      Color upper = clusterBounds(n, tree.type, g, sp, frames, visible ? &lower : nullptr, &smooth);
+      // A tree that mixes groups bounds from below with their lower envelope (LightTree).
+      Color upper = clusterBounds(n, tree.type, tree.bound, sp, frames, visible ? &lower : nullptr, &smooth,
+                                  tree.mixedGroups ? &tree.boundLow : nullptr);
       float b = luminance(upper);
       if (b > 0) {
         // A node in the heap may be refined next: fetch its children while we work.
@@ -304,7 +305,8 @@ class Lightcuts final : public LightEvaluator {
       if (tree.nodes.empty()) continue;
       const LightNode& root = tree.nodes[0];
       ShadowResult shadow;
-      Color unit = shadowedUnit(lights_.lights[root.rep], lights_.groups[tree.group], sp, vis, stats, shadow,
+      const Light& rootRep = lights_.lights[root.rep];
+      Color unit = shadowedUnit(rootRep, lights_.groups[rootRep.group], sp, vis, stats, shadow,
                                 probes && tree.lightCount(0) >= kProbeMinLights);
       addNode(t, 0, unit, shadow);
       ++cutRoots;
@@ -333,7 +335,6 @@ class Lightcuts final : public LightEvaluator {
       double& sum = cn.scaled ? sumScaled : sumSq;
       sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
       const LightTree& tree = forest_.trees[cn.tree];
-      const LightGroup& g = lights_.groups[tree.group];
       if (probes && cn.shadow.blocker >= 0 && cn.lights >= kProbeMinLights &&
           hiddenCluster(tree.nodes[cn.node], tree.type, sp, cn.shadow, vis, stats)) {
         // Its representative is hidden, and so is the whole cluster: it stays in the cut,
@@ -352,7 +353,8 @@ class Lightcuts final : public LightEvaluator {
         // Only clusters that may be probed need to know what hid their representative.
         shadows[k] = cn.shadow;
         units[k] = rep == cn.rep ? cn.unit
-                                : shadowedUnit(lights_.lights[rep], g, sp, vis, stats, shadows[k],
+                                : shadowedUnit(lights_.lights[rep], lights_.groups[lights_.lights[rep].group], sp,
+                                               vis, stats, shadows[k],
                                                probes && tree.lightCount(c) >= kProbeMinLights);
       }
       // A shadow boundary: one child's representative is hidden, the other's not.
@@ -410,7 +412,8 @@ class Lightcuts final : public LightEvaluator {
         const LightTree& tree = forest_.trees[cn.tree];
         const LightNode& n = tree.nodes[cn.node];
         // A first-order node is never a leaf: its moments are stored.
-        Color fo = vmax(firstOrderUnit(lights_.lights[cn.rep], lights_.groups[tree.group], sp,
+        const Light& rep = lights_.lights[cn.rep];
+        Color fo = vmax(firstOrderUnit(rep, lights_.groups[rep.group], sp,
                                        tree.moments[(cn.left - 1) / 2], cn.unit) * n.intensity, Color(0));
         float raw = luminance(cn.estimate), lf = luminance(fo);
         if (raw > 0 && lf > 0) {
@@ -452,7 +455,6 @@ class Lightcuts final : public LightEvaluator {
   // surface and cast no ray) that of its brightest light, one shadow ray.
   Color exactDirectionalSum(const LightTree& tree, uint32_t node, const ShadingPoint& sp, Visibility& vis,
                             EvalStats& stats, CutVisibility found) const {
-    const LightGroup& g = lights_.groups[tree.group];
     static thread_local std::vector<uint32_t> stack;
     stack.assign(1, node);
     Vec3d sum;
@@ -469,7 +471,8 @@ class Lightcuts final : public LightEvaluator {
       Color mg;
       Vec3 wi;
       float dist;
-      if (!lightContribution(lights_.lights[n.rep], g, sp, mg, wi, dist)) continue;
+      const Light& l = lights_.lights[n.rep];
+      if (!lightContribution(l, lights_.groups[l.group], sp, mg, wi, dist)) continue;
       Color c = mg * n.intensity;
       sum += c;
       if (luminance(c) > brightest) {
@@ -553,7 +556,7 @@ class CourseCuts final : public LightEvaluator {
       auto [t, ni] = stack.back();
       stack.pop_back();
       const LightTree& tree = forest_.trees[t];
-      const LightGroup& g = lights_.groups[tree.group];
+      const LightGroup& g = tree.bound;  // the synthetic light's (a leaf uses its own)
       const LightNode& n = tree.nodes[ni];
       if (!n.isLeaf()) {
         const CourseNodeData& sd = seed_[t][ni];
@@ -593,7 +596,10 @@ class CourseCuts final : public LightEvaluator {
     const LightNode& n = tree.nodes[ni];
     blocked = false;
     ShadowResult found;
-    if (n.isLeaf()) return shadowedUnit(lights_.lights[n.rep], g, sp, vis, stats, found) * n.intensity;
+    if (n.isLeaf()) {
+      const Light& l = lights_.lights[n.rep];
+      return shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, found) * n.intensity;
+    }
     const CourseNodeData& sd = seed[ni];
     Light syn;
     syn.type = tree.type;

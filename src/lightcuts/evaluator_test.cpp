@@ -398,21 +398,20 @@ TEST(Precision, BruteForceOverMillionsOfDimLightsIsExact) {
   EXPECT_EQ(r.cutSize, kDim + 1);
 }
 
-// A forest of more trees than --max-cut (every spot light with its own cone is a tree of
-// its own) must still refine its large tree: each tree after the first adds one node to the
-// budget.
-// Stopping at the roots left 1,000 point lights as one representative.
+// A forest of more trees than --max-cut must still refine its large tree: each tree after
+// the first adds one node to the budget. Counting the roots against it left 1,000 point
+// lights as one representative.
 TEST(MaxCut, CountsRefinementsBeyondTheRoots) {
   LightSet s = cloud(1000, LightType::Omni, 5);
-  const uint32_t spots = 300;
+  const uint32_t spots = uint32_t(kMaxGroupTrees);  // a tree each (more would share one)
   for (uint32_t i = 0; i < spots; ++i) {
     LightGroup g;
-    g.falloff.cosCutoff = std::cos(0.3f + 0.002f * float(i));  // a group, so a tree, per spot
+    g.falloff.cosCutoff = std::cos(0.3f + 0.02f * float(i));
     s.groups.push_back(g);
     Light l;
     l.type = LightType::Spot;
     l.group = uint16_t(s.groups.size() - 1);
-    l.position = Vec3(float(i) * 0.01f - 2, 3, 0);
+    l.position = Vec3(float(i) * 0.1f - 2, 3, 0);
     l.direction = Vec3(0, -1, 0);
     l.intensity = Color(0.0001f);
     s.lights.push_back(l);
@@ -421,7 +420,7 @@ TEST(MaxCut, CountsRefinementsBeyondTheRoots) {
   ASSERT_EQ(f.trees.size(), spots + 1);
   auto bf = makeBruteForce(s);
   CutOptions o;
-  o.maxCut = 200;  // fewer than the trees
+  o.maxCut = 12;  // fewer than the trees
   auto lcut = makeLightcuts(s, f, o);
   Unoccluded vis;
   for (int i = 0; i < 10; ++i) {
@@ -429,12 +428,80 @@ TEST(MaxCut, CountsRefinementsBeyondTheRoots) {
     EvalStats st;
     EvalResult got = lcut->evaluate(sp, vis, st);
     EXPECT_GT(got.cutSize, spots + 1) << "no refinement at point " << i;
-    EXPECT_LE(got.cutSize, spots + 200u);
-    Color want = bf->evaluate(sp, vis, st).radiance;
-    EXPECT_NEAR(luminance(got.radiance), luminance(want), 0.03f * luminance(want)) << "point " << i;
+    EXPECT_LE(got.cutSize, spots + 12u);
   }
 }
 
+// Spots that each have their own cone share one tree (LightTree::mixedGroups) whose bounds
+// use the groups' upper envelope: the cut still converges to brute force, and the default
+// error holds.
+TEST(MixedGroups, ManyConesShareOneTreeAndStayWithinTheError) {
+  LightSet s;
+  Rng r(9, 1);
+  for (uint32_t i = 0; i < 600; ++i) {
+    LightGroup g;
+    g.atten = Attenuation{0.2f + 0.3f * r.uniform(), 0.1f * r.uniform(), 0.5f + r.uniform(), kInf};
+    float outer = 0.3f + 0.8f * r.uniform();
+    g.falloff.cosOuter = std::cos(outer);
+    g.falloff.cosInner = std::cos(outer * 0.7f);
+    g.falloff.exponent = i % 3 == 0 ? 2.0f : 0.0f;
+    s.groups.push_back(g);
+    Light l;
+    l.type = LightType::Spot;
+    l.group = uint16_t(i);
+    l.position = Vec3(r.uniform() * 4 - 2, 2 + r.uniform(), r.uniform() * 4 - 2);
+    l.direction = normalize(Vec3(r.uniform() - 0.5f, -1, r.uniform() - 0.5f));
+    l.intensity = Color(r.uniform(), r.uniform(), r.uniform()) * 0.01f;
+    s.lights.push_back(l);
+  }
+  LightForest f = buildLightForest(s);
+  ASSERT_EQ(f.trees.size(), 1u);
+  EXPECT_TRUE(f.trees[0].mixedGroups);
+  // Every node's bounds hold the sum of its lights' exact contributions.
+  const LightTree& t = f.trees[0];
+  for (int k = 0; k < 8; ++k) {
+    ShadingPoint sp = point(Vec3(r.uniform() * 4 - 2, 0, r.uniform() * 4 - 2));
+    BoundFrames fr(sp);
+    for (uint32_t ni = 0; ni < t.nodes.size(); ni += 7) {
+      std::vector<uint32_t> stack{ni};
+      double sum = 0;
+      while (!stack.empty()) {
+        const LightNode& n = t.nodes[stack.back()];
+        stack.pop_back();
+        if (!n.isLeaf()) {
+          stack.push_back(n.left);
+          stack.push_back(n.left + 1);
+          continue;
+        }
+        Color mg;
+        Vec3 wi;
+        float d;
+        const Light& l = s.lights[n.rep];
+        if (lightContribution(l, s.groups[l.group], sp, mg, wi, d)) sum += luminance(mg * l.intensity);
+      }
+      Color lower;
+      Color upper = clusterBounds(t.nodes[ni], t.type, t.bound, sp, fr, &lower, nullptr, &t.boundLow);
+      EXPECT_GE(double(luminance(upper)), sum * (1 - 1e-5)) << "node " << ni;
+      EXPECT_LE(double(luminance(lower)), sum * (1 + 1e-5) + 1e-12) << "node " << ni;
+    }
+  }
+  auto bf = makeBruteForce(s);
+  auto exact = makeLightcuts(s, f, CutOptions{0.0f, 1 << 30});
+  auto lcut = makeLightcuts(s, f, CutOptions{});
+  HalfBlocked vis;
+  for (int i = 0; i < 12; ++i) {
+    ShadingPoint sp = point(Vec3(float(i) * 0.3f - 1.8f, 0, 0.25f * float(i) - 1.5f));
+    EvalStats st;
+    Color want = bf->evaluate(sp, vis, st).radiance;
+    Color leaves = exact->evaluate(sp, vis, st).radiance;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(leaves[c], want[c], 1e-5f * (1 + want[c]));
+    Unoccluded open;
+    Color wantOpen = bf->evaluate(sp, open, st).radiance;
+    EvalResult got = lcut->evaluate(sp, open, st);
+    EXPECT_NEAR(luminance(got.radiance), luminance(wantOpen), 0.02f * luminance(wantOpen)) << "point " << i;
+    EXPECT_LT(got.cutSize, 600u);
+  }
+}
 
 }  // namespace
 }  // namespace lc::lightcuts

@@ -81,13 +81,16 @@ void coneUnion(const Vec3& a, float cosA, const Vec3& b, float cosB, Vec3& axis,
 
 namespace {
 
+// A tree's key: a light group, or (group >= kMixedKey) every group of one kind.
 struct GroupKey {
   LightType type;
-  uint16_t group;
+  uint32_t group;
   bool operator<(const GroupKey& o) const {
     return type != o.type ? type < o.type : group < o.group;
   }
 };
+constexpr uint32_t kMixedKey = 1u << 16;
+uint32_t kindOf(const LightGroup& g) { return uint32_t(g.diffuseOnly) | uint32_t(g.isVpl) << 1; }
 
 // Luminance in double: luminances near FLT_MAX would overflow a float sum.
 double lum(const Color& c) { return luminance(Vec3d(c)); }
@@ -327,6 +330,26 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
     if (!(luminance(l.intensity) > 0)) continue;
     groups[GroupKey{l.type, l.group}].push_back(uint32_t(i));
   }
+  // A kind with more groups than kMaxGroupTrees shares one tree that mixes them (measured:
+  // 30,000 point lights, each with its own attenuation, 2.5x faster than a tree each; cutting
+  // the groups, sorted, into 16 trees with tighter envelopes was 10% faster there but left
+  // more pixels over 2% on 15,000 spots with their own cones).
+  std::map<GroupKey, size_t> perKind;
+  for (auto& [k, v] : groups) ++perKind[GroupKey{k.type, kindOf(lights.groups[k.group])}];
+  for (auto it = groups.begin(); it != groups.end();) {
+    if (it->first.group >= kMixedKey) {
+      ++it;
+      continue;
+    }
+    const GroupKey kind{it->first.type, kindOf(lights.groups[it->first.group])};
+    if (perKind[kind] <= kMaxGroupTrees) {
+      ++it;
+      continue;
+    }
+    std::vector<uint32_t>& mixed = groups[GroupKey{kind.type, kMixedKey + kind.group}];
+    mixed.insert(mixed.end(), it->second.begin(), it->second.end());
+    it = groups.erase(it);
+  }
   LightForest forest;
   forest.trees.resize(groups.size());
   std::vector<std::pair<GroupKey, const std::vector<uint32_t>*>> work;
@@ -361,7 +384,19 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
     if (t.preorder.size() != t.nodes.size()) computePreorder(t);
     if (k.type == LightType::Directional) computeDirectionCones(lights, t);
     t.type = k.type;
-    t.group = k.group;
+    if (k.group < kMixedKey) {
+      t.group = uint16_t(k.group);
+      t.bound = lights.groups[t.group];
+    } else {
+      t.mixedGroups = true;
+      t.group = lights.lights[idx.front()].group;
+      t.bound = t.boundLow = lights.groups[t.group];
+      for (uint32_t li : idx) {
+        const LightGroup& g = lights.groups[lights.lights[li].group];
+        t.bound = upperEnvelope(t.bound, g);
+        t.boundLow = lowerEnvelope(t.boundLow, g);
+      }
+    }
     forest.trees[i] = std::move(t);
   });
   progress.finish();

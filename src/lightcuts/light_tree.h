@@ -59,7 +59,15 @@ struct NodeMoments {
 
 struct LightTree {
   LightType type = LightType::Omni;
-  uint16_t group = 0;
+  uint16_t group = 0;  // its lights' group (a tree that mixes groups: its first light's)
+  // What the tree's bounds use: its lights' group or, for a tree that mixes groups
+  // (mixedGroups: a scene with more than kMaxGroupTrees groups of one kind, say spots that
+  // each have their own cone), their upper envelope (core/light.h), which bounds every
+  // light's model from above; its lower bounds use their lower envelope (boundLow), and it
+  // has no first-order estimates. A light's own contribution always uses its own group.
+  LightGroup bound;
+  LightGroup boundLow;  // mixed trees: the groups' lower envelope, for lower bounds
+  bool mixedGroups = false;
   BigVector<LightNode> nodes;  // nodes[0] is the root
   // Parallel to nodes when filled: the seed builder fills it; agglomerative trees leave it
   // empty (unless TreeBuildOptions::courseData) and makeCourseCuts computes it on demand.
@@ -86,6 +94,11 @@ struct LightTree {
 
 // Course: the course project's k-d split (`--tree seed` or `course`).
 enum class TreeBuilder { Agglomerative, Course };
+
+// Lights of one kind (type, diffuseOnly, isVpl) in more groups than this share one tree
+// (LightTree::mixedGroups): a tree per group would leave thousands of one-light trees, every
+// one of them in every cut.
+constexpr size_t kMaxGroupTrees = 16;
 
 struct TreeBuildOptions {
   TreeBuilder builder = TreeBuilder::Agglomerative;

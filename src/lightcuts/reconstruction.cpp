@@ -157,10 +157,10 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       const float factor = firstOrder == count && exact > 0 ? factorSum / float(exact) : 1.0f;
       const bool batched = !needsRay && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
       if (batched) {
-        out.batch.add(lights.lights[n.rep], lights.groups[tree.group], n.intensity * factor);
+        out.batch.add(lights.lights[n.rep], lights.groups[lights.lights[n.rep].group], n.intensity * factor);
         out.batchNodes.push_back(uint32_t(out.nodes.size()));
       }
-      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, tree.group, needsRay, batched, disagree, factor, t, it.node});
+      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, lights.lights[n.rep].group, needsRay, batched, disagree, factor, t, it.node});
     }
   }
   for (size_t g = 0; g < out.batchNodes.size(); g += MergedCut::kGroupSize) {

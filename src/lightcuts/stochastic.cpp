@@ -52,7 +52,7 @@ class StochasticLightcuts final : public LightEvaluator {
     auto bound = [&](uint32_t t, uint32_t ni) {
       const LightTree& tree = forest_.trees[t];
       ++stats.boundsEvaluated;
-      return luminance(clusterBounds(tree.nodes[ni], tree.type, lights_.groups[tree.group], sp, frames, nullptr));
+      return luminance(clusterBounds(tree.nodes[ni], tree.type, tree.bound, sp, frames, nullptr));
     };
     // The cut: refine the cluster of the largest bound until the cut has the size asked for.
     for (uint32_t t = 0; t < forest_.trees.size(); ++t) {
@@ -105,7 +105,7 @@ class StochasticLightcuts final : public LightEvaluator {
       Color mg;
       Vec3 wi;
       float dist;
-      if (!lightContribution(l, lights_.groups[tree.group], sp, mg, wi, dist)) continue;
+      if (!lightContribution(l, lights_.groups[l.group], sp, mg, wi, dist)) continue;
       ++stats.shadowRays;
       Color v = vis(wi, dist);
       stats.occludedRays += isBlack(v);

@@ -732,8 +732,7 @@ std::vector<ObjectLightInfo> addObjectLights(scene::Scene& scene, const ObjectLi
     const Luminosity& l = *e.lum;
     LightGroup g;
     g.atten = Attenuation{l.attenConstant, l.attenLinear, l.attenQuadratic, kInf};
-    if (set.groups.size() >= 65535 && !(std::find(set.groups.begin(), set.groups.end(), g) != set.groups.end()))
-      throw Error(l.loc, "too many distinct light groups (attenuations) in the scene");
+    if (!set.hasRoomFor(g)) throw Error(l.loc, "too many distinct light groups (attenuations) in the scene");
     Writer w;
     w.out = set.lights.data() + base;
     w.colour = &l.colour;

@@ -262,6 +262,8 @@ std::unique_ptr<Scene> Scene::build(const io::SceneDesc& desc, const BuildOption
     if (!isFinite(l.position) || !isFinite(l.intensity) || !isFinite(l.direction))
       throw Error(ld.loc, "light parameters must be finite");
     if (isBlack(l.intensity)) continue;
+    if (!s.lights_.hasRoomFor(g))
+      throw Error(ld.loc, "more than 65535 distinct light groups (attenuations, spot cones) in the scene");
     l.group = s.lights_.groupFor(g);
     s.lights_.lights.push_back(l);
   }

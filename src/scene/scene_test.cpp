@@ -181,6 +181,27 @@ TEST(Scene, SingularTransformIsAnError) {
   }
 }
 
+// Light::group is 16 bits: the 65,536th distinct attenuation is an error at its light, not
+// a wrapped index that silently gives it another light's model.
+TEST(Scene, TooManyDistinctLightGroupsIsAnErrorAtTheLight) {
+  io::SceneDesc d;
+  for (int i = 0; i < 65536; ++i) {
+    io::LightDesc l;
+    l.attenConstant = 0.1f + float(i) * 1e-5f;
+    l.loc = SourceLoc{"x.ray", i + 1, 1};
+    d.lights.push_back(l);
+  }
+  d.lights.back().attenConstant = d.lights.front().attenConstant;  // a group already seen: fine
+  EXPECT_NO_THROW(Scene::build(d));
+  d.lights.back().attenConstant = 0.05f;  // the 65,536th distinct one
+  try {
+    Scene::build(d);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("x.ray:65536:1"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Scene, TransmittanceMultipliesThroughGlass) {
   io::SceneDesc d;
   io::MaterialDesc glass;
