@@ -6,8 +6,8 @@ must not change what the renderer computes (issue 28). Python's standard library
     OLD=... NEW=... scripts/check_identical.py --quick                          # a fast subset
     OLD=... NEW=... scripts/check_identical.py scenes/cornell_box.ray --size 32 # some scenes
 
-Each scene renders with each binary, small (--size, default 64 x 64) and with --threads
-(default 2), to an EXR with every AOV layer (cut size and shadow rays per pixel too). The
+Each scene renders with each binary, small (--size, default 64 x 64; 136 x 136 under
+reconstruction cuts, whose tiles are 64 pixels) and with --threads (default 2), to an EXR with every AOV layer (cut size and shadow rays per pixel too). The
 binaries run from twin folders as `./lightcuts` with the same arguments, so the files' text
 metadata (the command line) agrees and the EXR files must be equal byte for byte. Beside the
 default render, variants exercise what the default at this size leaves out: reconstruction
@@ -29,21 +29,25 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
-# Flags added to every scene's default render, by name.
+# Every scene renders once per variant: name -> (flags, size or None for --size). Under
+# reconstruction cuts tiles are 64 pixels or more, so that variant renders 136 x 136: nine
+# tiles that share the samples on their edges, the last ones partial.
 VARIANTS = {
-    "default": [],
-    "recon": ["--reconstruct", "4", "--reference-pixels", "64"],
+    "default": ([], None),
+    "recon": (["--reconstruct", "4", "--reference-pixels", "64"], 136),
 }
-# Variants on one scene each (scene, name, flags): paths the suite's defaults do not take.
+# Variants on one scene each (scene, name, flags, size or None): paths the suite's defaults
+# do not take.
 EXTRA = [
-    ("scenes/cornell_box.ray", "recon-coarse0", ["--reconstruct", "2", "--reconstruct-coarse", "0"]),
-    ("scenes/cornell_box.ray", "seed", ["--method", "seed", "--reference-pixels", "32"]),
-    ("scenes/cornell_box.ray", "stochastic", ["--method", "stochastic", "--spp", "2"]),
-    ("scenes/cornell_box.ray", "brute", ["--method", "brute", "--vpls", "500"]),
-    ("scenes/cornell_box.ray", "vpl-object", ["--vpl-normalize", "object", "--vpls", "2000"]),
+    ("scenes/cornell_box.ray", "recon-coarse0", ["--reconstruct", "2", "--reconstruct-coarse", "0"], 80),
+    ("scenes/cornell_box.ray", "recon-spp2-aa24", ["--reconstruct", "4", "--spp", "2", "--aa-samples", "24"], 136),
+    ("scenes/cornell_box.ray", "seed", ["--method", "seed", "--reference-pixels", "32"], None),
+    ("scenes/cornell_box.ray", "stochastic", ["--method", "stochastic", "--spp", "2"], None),
+    ("scenes/cornell_box.ray", "brute", ["--method", "brute", "--vpls", "500"], None),
+    ("scenes/cornell_box.ray", "vpl-object", ["--vpl-normalize", "object", "--vpls", "2000"], None),
     ("scenes/cornell_box.ray", "probes-off-walter",
-     ["--visibility-probes", "off", "--cut-criterion", "walter", "--gi", "off", "--aa", "off"]),
-    ("scenes/green_light_emitter.ray", "error-floor0", ["--error-floor", "0", "--error", "0.05"]),
+     ["--visibility-probes", "off", "--cut-criterion", "walter", "--gi", "off", "--aa", "off"], None),
+    ("scenes/green_light_emitter.ray", "error-floor0", ["--error-floor", "0", "--error", "0.05"], None),
 ]
 QUICK = ["scenes/cornell_box.ray", "scenes/green_light_emitter.ray", "scenes/mirror_ring.ray",
          "scenes/ball_lens.ray", "scenes/features/spotlights.ray"]
@@ -114,17 +118,18 @@ def main():
                              sorted(os.path.relpath(p, ROOT) for p in
                                     glob.glob(os.path.join(ROOT, "scenes", "*.ray")) +
                                     glob.glob(os.path.join(ROOT, "scenes", "features", "*.ray"))))
-    cases = [(s, v, VARIANTS[v]) for s in scenes for v in args.variants.split(",") if v]
+    cases = [(s, v) + VARIANTS[v] for s in scenes for v in args.variants.split(",") if v]
     if not args.no_extra:
-        cases += [(s, v, f) for s, v, f in EXTRA if args.scenes == [] or s in scenes]
+        cases += [c for c in EXTRA if args.scenes == [] or c[0] in scenes]
 
     work = tempfile.mkdtemp(prefix="check_identical_")
     failed = 0
-    for scene, variant, flags in cases:
+    for scene, variant, flags, size in cases:
+        size = size or args.size
         t0 = time.time()
-        sa, ea = run(args.old, os.path.join(work, "old"), scene, flags, args.size, args.threads)
-        sb, eb = run(args.new, os.path.join(work, "new"), scene, flags, args.size, args.threads)
-        label = f"{scene} [{variant}] {args.size}x{args.size}"
+        sa, ea = run(args.old, os.path.join(work, "old"), scene, flags, size, args.threads)
+        sb, eb = run(args.new, os.path.join(work, "new"), scene, flags, size, args.threads)
+        label = f"{scene} [{variant}] {size}x{size}"
         problems = []
         if sa is None or sb is None:
             if (sa is None) != (sb is None) or ea != eb:

@@ -23,6 +23,7 @@
 #include "io/colormap.h"
 #include "io/image.h"
 #include "lightcuts/evaluator.h"
+#include "render/reference_pixels.h"
 #include "render/renderer.h"
 
 namespace lc::app {
