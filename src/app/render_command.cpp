@@ -53,7 +53,7 @@ struct RenderArgs {
   int stochasticCut = lightcuts::CutOptions{}.stochasticCut;
   std::string criterion = "total";
   std::string estimator = "first-order";
-  std::string visibilityProbes = "on";
+  bool visibilityProbes = lightcuts::CutOptions{}.visibilityProbes;
   std::string cutHeatmap;
   int referencePixels = 0;
   std::string errorFloor = "auto";
@@ -326,7 +326,7 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
   lightcuts::LightForest forest;
   std::unique_ptr<lightcuts::LightEvaluator> evaluator;
   lightcuts::CutOptions co{error, a.maxCut, lightcuts::parseCutCriterion(a.criterion),
-                           lightcuts::parseEstimator(a.estimator), a.visibilityProbes == "on"};
+                           lightcuts::parseEstimator(a.estimator), a.visibilityProbes};
   co.stochasticCut = a.stochasticCut;
   co.seed = a.seed;
   if (method == lightcuts::Method::Brute) {
@@ -466,7 +466,7 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
     j["error_floor_pixels"] = rr.stats.errorFloorPixels;
     j["cut_criterion"] = a.criterion;
     j["estimator"] = a.estimator;
-    j["visibility_probes"] = a.visibilityProbes;
+    j["visibility_probes"] = switchName(a.visibilityProbes);
     j["probed_clusters"] = es.probedClusters;
     j["probe_rays"] = es.probeRays;
     j["occluded_shadow_rays"] = es.occludedRays;
@@ -749,11 +749,10 @@ void addRenderCommand(CLI::App& app) {
                             "default {}", d.estimator))
       ->check(CLI::IsMember({"first-order", "representative"}))
       ->group(cuts);
-  c->add_option("--visibility-probes", a->visibilityProbes,
-                fmt::format("Lightcuts: before refining a cluster whose representative is hidden, test the corners of "
-                            "its box; when one convex object hides them all, the cluster stays in the cut as hidden "
-                            "(on) or not (off, as published); default {}", d.visibilityProbes))
-      ->check(CLI::IsMember({"on", "off"}))
+  addSwitch(*c, "--visibility-probes", a->visibilityProbes,
+            fmt::format("Lightcuts: before refining a cluster whose representative is hidden, test the corners of "
+                        "its box; when one convex object hides them all, the cluster stays in the cut as hidden "
+                        "(on) or not (off, as published); default {}", switchName(d.visibilityProbes)))
       ->group(cuts);
   c->add_option("--reference-pixels", a->referencePixels,
                 fmt::format("Also run brute force at K pixels: report the measured error and the estimated "
