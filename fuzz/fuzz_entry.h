@@ -120,7 +120,7 @@ inline void loadScene(const uint8_t* data, size_t size, const std::string& baseD
     v.maxVpls = tinyLimits().maxVpls;
     if (ir.vpls) v.count = std::min(*ir.vpls, 200);
     if (ir.bounces) v.bounces = std::min(*ir.bounces, 8);
-    if (ir.normalize) v.normalize = lights::parseVplNormalize(*ir.normalize);
+    if (ir.normalize) v.normalize = *ir.normalize;
     if (ir.clamp) v.clamp = *ir.clamp;
     if (ir.seed) v.seed = *ir.seed;
     if (v.count > 0) (void)lights::addVpls(*s, v);

@@ -1,4 +1,5 @@
-// `lightcuts render`: load, light, render, write the image, report.
+// `lightcuts render`: set up (load, light, size, evaluator), render, report (the image,
+// then --stats and the summary, summary.h).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include "app/distributed.h"
 #include "app/interrupt.h"
 #include "app/progress.h"
+#include "app/render_args.h"
 #include "app/scene_loader.h"
 #include "app/scene_options.h"
 #include "app/summary.h"
@@ -23,6 +25,7 @@
 #include "io/colormap.h"
 #include "io/image.h"
 #include "lightcuts/evaluator.h"
+#include "render/reference_pixels.h"
 #include "render/renderer.h"
 
 namespace lc::app {
@@ -31,38 +34,6 @@ namespace {
 
 constexpr int kMaxImageSide = 1 << 16;  // --width, --height and sizes from the aspect ratio
 constexpr int kDefaultWidth = 512;      // when neither --width nor --height is given
-
-
-struct RenderArgs {
-  std::string scene;
-  std::string out;
-  int width = 0, height = 0;
-  int spp = render::RenderOptions{}.spp;
-  std::string aa = render::antiAliasingName(render::RenderOptions{}.aa);
-  int aaSamples = render::RenderOptions{}.aaSamples;
-  std::string aov;  // comma-separated kAovNames
-  int threads = 0;
-  int maxDepth = 5;
-  std::string stats;
-  bool quiet = false;
-  std::string method = "lightcuts";
-  std::string tree;  // default: by method
-  float error = -1;  // default: by method
-  int maxCut = lightcuts::CutOptions{}.maxCut;
-  int stochasticCut = lightcuts::CutOptions{}.stochasticCut;
-  std::string criterion = "total";
-  std::string estimator = "first-order";
-  std::string visibilityProbes = "on";
-  std::string cutHeatmap;
-  int referencePixels = 0;
-  std::string errorFloor = "auto";
-  std::string reconstruct = "auto";
-  std::string reconstructCoarse = "auto";
-  std::string tonemap = "srgb";
-  float exposure = 0;  // EV: 8-bit outputs scale linear values by 2^exposure
-  uint64_t seed = 1;
-  LoadOptions load;
-};
 
 // --error's defaults live with the cut options (lightcuts/evaluator.h).
 constexpr float kLightcutsDefaultError = lightcuts::CutOptions{}.errorRatio;
@@ -172,33 +143,6 @@ std::string defaultOutput(const std::string& scene) {
   return stem + ".png";
 }
 
-// Every rank's part of a distributed render, as JSON: rank 0 puts it under "mpi" in --stats
-// and adds the counters ("counters", removed there) to the job's totals.
-nlohmann::json rankJson(const Cluster& cluster, int threads, const LoadedScene& ls, double treeSeconds,
-                        const render::RenderResult& rr) {
-  const auto& st = rr.stats;
-  uint64_t rays = st.primaryRays + st.secondaryRays + st.eval.shadowRays;
-  return {{"rank", cluster.rank()},
-          {"host", cluster.host()},
-          {"threads", threads},
-          {"tiles", st.tiles},
-          {"pixels", st.pixels},
-          {"time_load_s", ls.loadSeconds},
-          {"time_accel_s", ls.accelSeconds},
-          {"time_lights_s", ls.lightSeconds},
-          {"time_tree_s", treeSeconds},
-          {"time_tiles_s", st.tileSeconds},
-          {"time_render_s", st.seconds},
-          {"time_reference_s", st.reference.bruteSeconds},
-          {"reference_pixels", st.reference.localPixels},
-          {"primary_rays", st.primaryRays},
-          {"secondary_rays", st.secondaryRays},
-          {"shadow_rays", st.eval.shadowRays},
-          {"shading_points", st.eval.shadingPoints},
-          {"rays_per_second", st.tileSeconds > 0 ? double(rays) / st.tileSeconds : 0},
-          {"counters", renderCountersJson(st)}};
-}
-
 int renderJob(RenderArgs& a, Cluster* cluster);
 
 int runRender(RenderArgs& a) {
@@ -224,65 +168,57 @@ int runRender(RenderArgs& a) {
   return status;
 }
 
-int renderJob(RenderArgs& a, Cluster* cluster) {
-  auto t0 = std::chrono::steady_clock::now();
-  const bool distributed = cluster && cluster->size() > 1;
-  const bool root = !cluster || cluster->rank() == 0;  // writes the image and reports
-  if (!root) a.quiet = true;
+// What a render is made of, from set-up to report.
+struct RenderSetup {
+  bool root = true;          // this process writes the image and reports
+  bool distributed = false;  // more than one process renders
+  std::string ext;           // the output's format
+  std::vector<std::string> aovs;
+  lightcuts::Method method = lightcuts::Method::Lightcuts;
+  lightcuts::TreeBuildOptions tb;
+  float error = 0;  // --error, resolved by method
+  io::ToneMap tonemap = io::ToneMap::Srgb;
+  LoadedScene ls;
+  lightcuts::LightForest forest;
+  std::unique_ptr<lightcuts::LightEvaluator> evaluator;
+  render::RenderOptions ro;
+};
+
+// The outputs and the options read before anything loads: a mistake fails at once, not
+// after a long render.
+void checkArgs(RenderArgs& a, RenderSetup& s) {
   if (a.out.empty()) a.out = defaultOutput(a.scene);
   checkDistinctPaths({{a.scene, "the scene"}, {a.out, "-o"}, {a.stats, "--stats"}, {a.cutHeatmap, "--cut-heatmap"}});
-  std::string ext = fileExtension(a.out);
+  std::string& ext = s.ext;
+  ext = fileExtension(a.out);
   if (std::filesystem::is_directory(a.out)) throw Error("cannot write '" + a.out + "': it is a directory");
   if (ext.empty())
     throw Error("cannot write '" + a.out + "': no file extension to choose the format (use .png, .ppm, .bmp or .exr)");
   if (!io::isWritableImageExtension(ext))
     throw Error("cannot write '" + a.out + "': unknown image format '." + ext + "' (use .png, .ppm, .bmp or .exr)");
-  const std::vector<std::string> aovs = a.aov.empty() ? std::vector<std::string>{} : parseAovs(a.aov);
-  if (!aovs.empty() && ext != "exr")
+  s.aovs = a.aov.empty() ? std::vector<std::string>{} : parseAovs(a.aov);
+  if (!s.aovs.empty() && ext != "exr")
     throw Error("--aov needs an .exr output (its layers are extra EXR channels); '" + a.out + "' is ." + ext);
   // Fail before a long render, not after it (only rank 0 writes).
-  if (root) {
+  if (s.root) {
     checkWritable(a.out);
     if (!a.stats.empty()) checkWritable(a.stats);
     if (!a.cutHeatmap.empty()) checkWritable(a.cutHeatmap);
   }
-  lightcuts::Method method = lightcuts::parseMethod(a.method);
-  lightcuts::TreeBuildOptions tb;
-  tb.builder = a.tree.empty() ? (method == lightcuts::Method::Course ? lightcuts::TreeBuilder::Course
-                                                                    : lightcuts::TreeBuilder::Agglomerative)
-                              : lightcuts::parseTreeBuilder(a.tree);
-  tb.seed = a.seed;
-  float error = a.error >= 0 ? a.error : (method == lightcuts::Method::Course ? kCourseDefaultError : kLightcutsDefaultError);
-  if (!std::isfinite(error)) throw Error("--error must be a finite number >= 0");
-  io::ToneMap tonemap = io::parseToneMap(a.tonemap);
+  s.method = lightcuts::parseMethod(a.method);
+  s.tb.builder = a.tree.empty() ? (s.method == lightcuts::Method::Course ? lightcuts::TreeBuilder::Course
+                                                                        : lightcuts::TreeBuilder::Agglomerative)
+                                : lightcuts::parseTreeBuilder(a.tree);
+  s.tb.seed = a.seed;
+  s.error = a.error >= 0 ? a.error
+                         : (s.method == lightcuts::Method::Course ? kCourseDefaultError : kLightcutsDefaultError);
+  if (!std::isfinite(s.error)) throw Error("--error must be a finite number >= 0");
+  s.tonemap = io::parseToneMap(a.tonemap);
   if (!std::isfinite(a.exposure)) throw Error("--exposure must be a finite number");
+}
 
-  a.load.threads = a.threads;
-  a.load.objectLights.seed = a.seed;  // shifts the stratified object-light points
-  a.load.envSeed = a.seed;            // shifts the environment lights' point set
-  // sRGB texture maps (from MTL files) are linearised whenever the output is display-encoded
-  // (srgb, filmic; the EXR of such a render too, so that both formats hold one linear image);
-  // --tonemap clamp keeps the course renderer's look: textures and output as stored.
-  a.load.linearizeSrgbTextures = tonemap != io::ToneMap::Clamp;
-  a.load.quiet = a.quiet;
-  a.load.interruptible = true;
-  LoadedScene ls;
-  try {
-    ls = loadScene(a.scene, a.load);
-  } catch (const Interrupted&) {
-    // Stopped while making the lights: nothing rendered, nothing written.
-    if (root) fmt::print(stderr, "lightcuts: interrupted; {} untouched\n", a.out);
-    return interruptExitStatus();
-  }
-  scene::Scene& scene = *ls.scene;
-  // The loader's warnings carry their location: "file:line:col: warning: ...".
-  if (root)
-    for (const std::string& w : ls.warnings) fmt::print(stderr, "lightcuts: {}\n", w);
-  if (!ls.objDescription.empty() && !a.quiet)
-    fmt::print(stderr, "OBJ input: added a default camera and lights:\n{}\n", ls.objDescription);
-
-  // Image size: from the flags, completing the missing one from the aspect ratio.
-  const auto& cam = scene.desc().camera;
+// The image size from the flags, completing the missing one from the aspect ratio.
+void resolveImageSize(RenderArgs& a, const io::CameraDesc& cam) {
   // In double, checked against the flags' bound before converting: an aspect ratio of 3e9
   // would otherwise overflow int (and wrap to a 1-pixel or negative size).
   double aspect = cam.aspectRatio ? double(*cam.aspectRatio) : 1.0;
@@ -301,45 +237,34 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
   if (uint64_t(a.width) * uint64_t(a.height) > a.load.limits.maxImagePixels)
     throw Error(fmt::format("an image of {}x{} exceeds --max-image-pixels ({})", a.width, a.height,
                             a.load.limits.maxImagePixels));
-  processBudget().reserve(uint64_t(a.width) * uint64_t(a.height) * memory_cost::kPixel,
-                          fmt::format("the {}x{} image's buffers", a.width, a.height));
-  io::CameraDesc camera = cam;
-  if (!ls.objDescription.empty() && a.width < a.height) {
-    // The OBJ default camera fits the model's bounding sphere in its vertical field of view;
-    // a portrait image would cut the sides, so the field is widened to fit it across instead.
-    float half = std::tan(camera.fovDegrees * kPi / 360.0f) * float(a.height) / float(a.width);
-    camera.fovDegrees = std::atan(half) * 360.0f / kPi;
-  }
-  scene.setCamera(scene::Camera::fromDesc(camera, float(a.width) / float(a.height)));
-  // (after the checks above: an error is not preceded by warnings about a render that will not run)
-  if (root && scene.lights().size() == 0)
-    printWarning("the scene has no lights: only emissive and ambient colours will show (add a point_light, "
-                 "directional_light, spot_light or area_light, or a luminosity to a material)");
-  const bool objInput = fileExtension(a.scene) == "obj";
-  if (root && objInput && !ls.objectLights.empty() && ls.vpls.vpls == 0 && a.load.gi && !a.load.vplCount)
-    printHint("the OBJ's emissive materials light what they see directly, nothing bounces; --vpls 10000 adds "
-              "indirect light (global illumination)");
+}
 
-  // Light tree and evaluator; oriented lights weigh their normal cones by the scene's size.
-  tb.sceneDiagonal = scene.bounds().diagonal();
-  lightcuts::LightForest forest;
-  std::unique_ptr<lightcuts::LightEvaluator> evaluator;
-  lightcuts::CutOptions co{error, a.maxCut, lightcuts::parseCutCriterion(a.criterion),
-                           lightcuts::parseEstimator(a.estimator), a.visibilityProbes == "on"};
+// The light tree and the evaluator; oriented lights weigh their normal cones by the
+// scene's size.
+void buildEvaluator(const RenderArgs& a, RenderSetup& s) {
+  const scene::Scene& scene = *s.ls.scene;
+  s.tb.sceneDiagonal = scene.bounds().diagonal();
+  lightcuts::CutOptions co{s.error, a.maxCut, lightcuts::parseCutCriterion(a.criterion),
+                           lightcuts::parseEstimator(a.estimator), a.visibilityProbes};
   co.stochasticCut = a.stochasticCut;
   co.seed = a.seed;
-  if (method == lightcuts::Method::Brute) {
-    evaluator = lightcuts::makeBruteForce(scene.lights());
+  if (s.method == lightcuts::Method::Brute) {
+    s.evaluator = lightcuts::makeBruteForce(scene.lights());
   } else {
     ProgressBar bar("light tree", a.quiet);
-    tb.progress = [&](double f) { bar.update(f); };
-    forest = lightcuts::buildLightForest(scene.lights(), tb);
+    s.tb.progress = [&](double f) { bar.update(f); };
+    s.forest = lightcuts::buildLightForest(scene.lights(), s.tb);
     bar.finish();
-    evaluator = method == lightcuts::Method::Course         ? lightcuts::makeCourseCuts(scene.lights(), forest, co)
-                : method == lightcuts::Method::Stochastic ? lightcuts::makeStochasticLightcuts(scene.lights(), forest, co)
-                                                          : lightcuts::makeLightcuts(scene.lights(), forest, co);
+    s.tb.progress = nullptr;  // (the bar ends here)
+    s.evaluator = s.method == lightcuts::Method::Course
+                      ? lightcuts::makeCourseCuts(scene.lights(), s.forest, co)
+                  : s.method == lightcuts::Method::Stochastic
+                      ? lightcuts::makeStochasticLightcuts(scene.lights(), s.forest, co)
+                      : lightcuts::makeLightcuts(scene.lights(), s.forest, co);
   }
+}
 
+render::RenderOptions renderOptions(const RenderArgs& a, lightcuts::Method method) {
   render::RenderOptions ro;
   ro.width = a.width;
   ro.height = a.height;
@@ -354,9 +279,82 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
   ro.errorFloor = a.errorFloor == "auto" ? -1.0f : std::stof(a.errorFloor);
   ro.reconstructSpacing = method == lightcuts::Method::Lightcuts ? reconstructSpacing(a.reconstruct, a.width, a.height) : 0;
   ro.reconstructCoarseSpacing = reconstructCoarseSpacing(a.reconstructCoarse, ro.reconstructSpacing);
+  return ro;
+}
+
+// Set-up: checks, the scene with its lights, the image size and camera, the evaluator and
+// the render's options. False when interrupted while making the lights.
+bool setUpRender(RenderArgs& a, Cluster* cluster, RenderSetup& s) {
+  s.distributed = cluster && cluster->size() > 1;
+  s.root = !cluster || cluster->rank() == 0;
+  if (!s.root) a.quiet = true;
+  checkArgs(a, s);
+
+  a.load.threads = a.threads;
+  a.load.objectLights.seed = a.seed;  // shifts the stratified object-light points
+  a.load.envSeed = a.seed;            // shifts the environment lights' point set
+  // sRGB texture maps (from MTL files) are linearised whenever the output is display-encoded
+  // (srgb, filmic; the EXR of such a render too, so that both formats hold one linear image);
+  // --tonemap clamp keeps the course renderer's look: textures and output as stored.
+  a.load.linearizeSrgbTextures = s.tonemap != io::ToneMap::Clamp;
+  a.load.quiet = a.quiet;
+  a.load.interruptible = true;
+  try {
+    s.ls = loadScene(a.scene, a.load);
+  } catch (const Interrupted&) {
+    // Stopped while making the lights: nothing rendered, nothing written.
+    if (s.root) fmt::print(stderr, "lightcuts: interrupted; {} untouched\n", a.out);
+    return false;
+  }
+  scene::Scene& scene = *s.ls.scene;
+  // The loader's warnings carry their location: "file:line:col: warning: ...".
+  if (s.root)
+    for (const std::string& w : s.ls.warnings) fmt::print(stderr, "lightcuts: {}\n", w);
+  if (!s.ls.objDescription.empty() && !a.quiet)
+    fmt::print(stderr, "OBJ input: added a default camera and lights:\n{}\n", s.ls.objDescription);
+
+  const auto& cam = scene.desc().camera;
+  resolveImageSize(a, cam);
+  processBudget().reserve(uint64_t(a.width) * uint64_t(a.height) * memory_cost::kPixel,
+                          fmt::format("the {}x{} image's buffers", a.width, a.height));
+  io::CameraDesc camera = cam;
+  if (!s.ls.objDescription.empty() && a.width < a.height) {
+    // The OBJ default camera fits the model's bounding sphere in its vertical field of view;
+    // a portrait image would cut the sides, so the field is widened to fit it across instead.
+    float half = std::tan(camera.fovDegrees * kPi / 360.0f) * float(a.height) / float(a.width);
+    camera.fovDegrees = std::atan(half) * 360.0f / kPi;
+  }
+  scene.setCamera(scene::Camera::fromDesc(camera, float(a.width) / float(a.height)));
+  // (after the checks above: an error is not preceded by warnings about a render that will not run)
+  if (s.root && scene.lights().size() == 0)
+    printWarning("the scene has no lights: only emissive and ambient colours will show (add a point_light, "
+                 "directional_light, spot_light or area_light, or a luminosity to a material)");
+  const bool objInput = fileExtension(a.scene) == "obj";
+  if (s.root && objInput && !s.ls.objectLights.empty() && s.ls.vpls.vpls == 0 && a.load.gi && !a.load.vplCount)
+    printHint("the OBJ's emissive materials light what they see directly, nothing bounces; --vpls 10000 adds "
+              "indirect light (global illumination)");
+
+  buildEvaluator(a, s);
+  s.ro = renderOptions(a, s.method);
+  return true;
+}
+
+// What the render step leaves for the report.
+struct RenderRun {
+  render::RenderResult rr;
+  // A distributed render: every rank's statistics (rankStatsJson), and the load balance.
+  nlohmann::json perRank = nlohmann::json::array();
+  double loadBalance = 1;
+};
+
+// Render: the image (its tiles shared with the other ranks of a distributed render), with
+// progress bars and Ctrl-C, then every rank's statistics to rank 0. An exit status when
+// the job ends here (interrupted; or a rank other than 0, its part done).
+std::optional<int> renderImage(const RenderArgs& a, Cluster* cluster, RenderSetup& s, RenderRun& run) {
+  render::RenderOptions& ro = s.ro;
   ro.cancel = &interruptFlag();
   std::unique_ptr<render::WorkShare> share;
-  if (distributed) {
+  if (s.distributed) {
     share = cluster->workShare(&interruptFlag());
     ro.share = share.get();
   }
@@ -365,13 +363,17 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
   ProgressBar refBar("reference pixels", a.quiet);
   ro.referenceProgress = [&](double f) { refBar.update(f); };
   std::optional<InterruptScope> interrupts(std::in_place);
-  render::RenderResult rr = render::render(scene, *evaluator, ro);
+  run.rr = render::render(*s.ls.scene, *s.evaluator, ro);
   bar.finish();
   refBar.finish();
   interrupts.reset();
+  // (the bars go out of scope here: the options must not call them later)
+  ro.progress = nullptr;
+  ro.referenceProgress = nullptr;
+  render::RenderResult& rr = run.rr;
 
   if (rr.interrupted || interruptFlag().load()) {
-    if (!root) {
+    if (!s.root) {
       // Rank 0 keeps what it gathered. The launcher passes a Ctrl-C on to every rank as
       // SIGTERM, and when one rank exits it kills the others at once (Open MPI's mpirun):
       // so wait here, and let rank 0 write the partial image in the second mpirun gives
@@ -385,20 +387,19 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
     po.metadata = metadata(a);
     io::writeImage(partial, rr.image, po);
     fmt::print(stderr, "lightcuts: interrupted; {} untouched, partial image in {}\n", a.out, partial);
-    if (distributed && interruptSignal() == SIGTERM)
+    if (s.distributed && interruptSignal() == SIGTERM)
       fmt::print(stderr, "lightcuts: (under MPI, SIGTERM comes from the launcher: the job was interrupted, or "
                          "another rank failed)\n");
     return interruptExitStatus();
   }
 
   // A distributed render: every rank's statistics to rank 0, added to the job's totals.
-  nlohmann::json perRank = nlohmann::json::array();
-  double loadBalance = 1;
-  if (distributed) {
+  if (s.distributed) {
     int threads = a.threads > 0 ? a.threads : int(std::thread::hardware_concurrency());
-    std::vector<std::string> all =
-        cluster->gather(rankJson(*cluster, threads, ls, forest.buildSeconds, rr).dump(), &interruptFlag());
-    if (!root) return 0;
+    std::vector<std::string> all = cluster->gather(
+        rankStatsJson(cluster->rank(), cluster->host(), threads, s.ls, s.forest.buildSeconds, rr).dump(),
+        &interruptFlag());
+    if (!s.root) return 0;
     if (all.size() != size_t(cluster->size())) throw Error("interrupted while gathering the ranks' statistics");
     double sumTiles = 0, maxTiles = 0;
     for (size_t r = 0; r < all.size(); ++r) {
@@ -407,19 +408,26 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
       j.erase("counters");
       sumTiles += j.at("time_tiles_s").get<double>();
       maxTiles = std::max(maxTiles, j.at("time_tiles_s").get<double>());
-      perRank.push_back(std::move(j));
+      run.perRank.push_back(std::move(j));
     }
     // Mean over max of the time each rank spent until its last tile: 1 when all finish together.
-    loadBalance = maxTiles > 0 ? sumTiles / double(all.size()) / maxTiles : 1;
+    run.loadBalance = maxTiles > 0 ? sumTiles / double(all.size()) / maxTiles : 1;
   }
+  return std::nullopt;
+}
 
-
+// Report: the image with its AOVs, the cut heatmap, then --stats and the terminal summary
+// (summary.h).
+void reportRender(const RenderArgs& a, Cluster* cluster, const RenderSetup& s, const RenderRun& run,
+                  std::chrono::steady_clock::time_point t0) {
+  const scene::Scene& scene = *s.ls.scene;
+  const render::RenderResult& rr = run.rr;
   io::WriteOptions wo;
-  wo.tonemap = tonemap;
+  wo.tonemap = s.tonemap;
   wo.exposure = a.exposure;
   wo.metadata = metadata(a);
-  wo.channels = aovChannels(aovs, scene, ro, rr);
-  if (ext != "exr") {
+  wo.channels = aovChannels(s.aovs, scene, s.ro, rr);
+  if (s.ext != "exr") {
     wo.metadata.emplace_back("Tone map", a.tonemap);
     wo.metadata.emplace_back("Exposure", fmt::format("{:g}", a.exposure));
   }
@@ -428,7 +436,7 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
     // Judged as displayed: the 8-bit output's tone map, or sRGB for an EXR viewed as usual.
     const auto& es = rr.stats.eval;
     RenderFacts facts{scene.lights().size(), rr.stats.primaryRays, es.shadingPoints, es.shadowRays, es.occludedRays};
-    std::string w = blackImageWarning(rr.image, ext == "exr" ? io::ToneMap::Srgb : tonemap, a.exposure, facts);
+    std::string w = blackImageWarning(rr.image, s.ext == "exr" ? io::ToneMap::Srgb : s.tonemap, a.exposure, facts);
     if (!w.empty()) printWarning(w);
   }
   if (!a.cutHeatmap.empty()) {
@@ -437,112 +445,17 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
     io::Image hm = io::heatmap(rr.cutSize, a.width, a.height, 0, maxCut, "lights per pixel (cut size)");
     io::writeImage(a.cutHeatmap, hm);
   }
-  double clampedFraction = ls.vpls.vpls ? render::vplClampedFraction(scene, ro) : 0;
-  double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  const auto& es = rr.stats.eval;
-  double perPoint = es.shadingPoints ? double(es.cutNodes) / double(es.shadingPoints) : 0;
-  double raysPerPoint = es.shadingPoints ? double(es.shadowRays) / double(es.shadingPoints) : 0;
-  uint64_t allRays = rr.stats.primaryRays + rr.stats.secondaryRays + es.shadowRays;
-  const render::ReferenceStats& ref = rr.stats.reference;
-
+  RenderReport report{a, s.ls, s.method, s.tb.builder, s.error, s.forest, s.ro, rr};
+  report.clampedFraction = s.ls.vpls.vpls ? render::vplClampedFraction(scene, s.ro) : 0;
+  report.totalSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (s.distributed) {
+    report.ranks = cluster->size();
+    report.loadBalance = run.loadBalance;
+    report.perRank = &run.perRank;
+  }
   if (!a.stats.empty()) {
-    nlohmann::json j;
-    j["scene"] = a.scene;
-    j["output"] = a.out;
-    j["width"] = a.width;
-    j["height"] = a.height;
-    j["spp"] = a.spp;
-    j["aa"] = a.spp == 1 ? a.aa : "off";
-    j["aa_samples"] = a.aaSamples;
-    j["aa_pixels"] = rr.stats.aaPixels;
-    j["aa_sub_samples"] = rr.stats.aaSubSamples;
-    j["threads"] = a.threads > 0 ? a.threads : int(std::thread::hardware_concurrency());
-    j["method"] = lightcuts::methodName(method);
-    j["error_threshold"] = error;
-    j["max_cut"] = a.maxCut;
-    j["error_floor"] = rr.stats.errorFloor;
-    j["error_floor_pixels"] = rr.stats.errorFloorPixels;
-    j["cut_criterion"] = a.criterion;
-    j["estimator"] = a.estimator;
-    j["visibility_probes"] = a.visibilityProbes;
-    j["probed_clusters"] = es.probedClusters;
-    j["probe_rays"] = es.probeRays;
-    j["occluded_shadow_rays"] = es.occludedRays;
-    j["hidden_clusters"] = es.hiddenClusters;
-    j["group_probes"] = es.groupProbes;
-    j["failed_group_probes"] = es.failedGroupProbes;
-    j["reconstruct_spacing"] = ro.reconstructSpacing;
-    j["reconstruct_coarse_spacing"] = ro.reconstructCoarseSpacing;
-    j["reconstruction_samples"] = rr.stats.reconstructionSamples;
-    j["reconstructed_points"] = es.reconstructedPoints;
-    j["reconstruction_fallbacks"] = rr.stats.reconstructionFallbacks;
-    j["reconstruction_coarse_cells"] = rr.stats.reconstructionCoarseCells;
-    j["max_depth"] = a.maxDepth;
-    j["tonemap"] = a.tonemap;
-    j["exposure"] = a.exposure;
-    j["time_total_s"] = total;
-    j["time_load_s"] = ls.loadSeconds;
-    j["time_accel_s"] = ls.accelSeconds;
-    j["time_lights_s"] = ls.lightSeconds;
-    j["time_tree_s"] = forest.buildSeconds;
-    j["time_render_s"] = rr.stats.seconds;
-    j["primary_rays"] = rr.stats.primaryRays;
-    j["secondary_rays"] = rr.stats.secondaryRays;
-    j["shadow_rays"] = es.shadowRays;
-    // Thread-seconds in shadow rays (estimated from a timed sample) and in light evaluation
-    // as a whole; their ratio is the share the rays leave to the cut's own work.
-    j["time_shadow_rays_s"] = es.shadowRaySeconds();
-    j["time_lighting_s"] = es.lightingSeconds();
-    j["shadow_ray_share"] = es.lightingSeconds() > 0 ? es.shadowRaySeconds() / es.lightingSeconds() : 0.0;
-    j["rays_per_second"] = rr.stats.seconds > 0 ? double(allRays) / rr.stats.seconds : 0;
-    j["shading_points"] = es.shadingPoints;
-    j["lights"] = lightCountsJson(scene.lights());
-    j["avg_lights_per_shading_point"] = perPoint;
-    j["avg_shadow_rays_per_shading_point"] = raysPerPoint;
-    j["bounds_evaluated"] = es.boundsEvaluated;
-    nlohmann::json hist = nlohmann::json::array();
-    for (size_t i = 0; i < es.cutHistogram.size(); ++i) {
-      if (!es.cutHistogram[i]) continue;
-      uint64_t lo = i == 0 ? 0 : (uint64_t(1) << (i - 1)), hi = (uint64_t(1) << i) - 1;
-      hist.push_back({{"min", lo}, {"max", hi}, {"count", es.cutHistogram[i]}});
-    }
-    j["cut_histogram"] = hist;
-    if (method != lightcuts::Method::Brute) {
-      j["tree_builder"] = lightcuts::treeBuilderName(tb.builder);
-      j["tree_nodes"] = forest.nodeCount();
-      j["tree_count"] = forest.trees.size();
-      j["tree_memory_bytes"] = forest.memoryBytes();
-    }
-    j["object_lights"] = objectLightsJson(ls.objectLights);
-    j["environment_lights"] = environmentLightsJson(ls.environmentLights);
-    j["vpls"] = {{"paths", ls.vpls.paths}, {"count", ls.vpls.vpls}, {"time_s", ls.vpls.seconds},
-                 {"clamp_distance", ls.vpls.clampDistance}};
-    j["vpl_clamped_fraction"] = clampedFraction;
-    j["caustic_lights"] = ls.caustics.lights;
-    j["caustics"] = {{"paths", ls.caustics.paths},
-                     {"lights", ls.caustics.lights},
-                     {"kind", lights::causticLightKindName(ls.caustics.kind)},
-                     {"time_s", ls.caustics.seconds},
-                     {"mean_radius", ls.caustics.meanRadius},
-                     {"power", {ls.caustics.power.x, ls.caustics.power.y, ls.caustics.power.z}}};
-    if (ref.pixels > 0) {
-      j["reference"] = {{"pixels", ref.pixels},
-                        {"brute_seconds", ref.bruteSeconds},
-                        {"brute_seconds_estimate", ref.bruteSecondsEstimate},
-                        {"test_seconds", ref.testSeconds},
-                        {"speedup_estimate", rr.stats.seconds > 0 ? ref.bruteSecondsEstimate / rr.stats.seconds : 0},
-                        {"mean_relative_error", ref.meanRelativeError},
-                        {"p99_relative_error", ref.p99RelativeError},
-                        {"max_relative_error", ref.maxRelativeError},
-                        {"fraction_over_2pct", ref.fractionOver2pct},
-                        {"fraction_over_threshold", ref.fractionOver2pct},
-                        {"threshold", render::ReferenceStats::kThreshold},
-                        {"brute_lights_per_shading_point", ref.bruteLightsPerShadingPoint}};
-    }
-    if (distributed)
-      j["mpi"] = {{"ranks", cluster->size()}, {"load_balance", loadBalance}, {"per_rank", perRank}};
-    std::string text = j.dump(2) + "\n";
+    std::string text = renderStatsJson(report).dump(2) + "\n";
     writeFileAtomically(a.stats, [&](const std::string& tmp) {
       FILE* f = std::fopen(tmp.c_str(), "wb");
       if (!f) throw Error("cannot write '" + a.stats + "'");
@@ -551,68 +464,16 @@ int renderJob(RenderArgs& a, Cluster* cluster) {
       if (!ok) throw Error("cannot write '" + a.stats + "'");
     });
   }
+  if (!a.quiet) printRenderSummary(report);
+}
 
-  if (!a.quiet) {
-    const LightSet& L = scene.lights();
-    fmt::print("scene      {} ({} objects, {} triangles)\n", a.scene, scene.shapes().size(), scene.triangleCount());
-    fmt::print("lights     {}\n", lightCountsLine(L));
-    if (ls.vpls.vpls)
-      fmt::print("vpls       {} from {} paths in {}; clamp at {:.4g} removes {:.1f}% of their light\n", ls.vpls.vpls,
-                 ls.vpls.paths, formatSeconds(ls.vpls.seconds), ls.vpls.clampDistance, 100 * clampedFraction);
-    if (ls.caustics.paths)
-      fmt::print("caustics   {} {} lights from {} paths in {} (footprint {:.4g}); shadow rays stop at glass\n",
-                 ls.caustics.lights, lights::causticLightKindName(ls.caustics.kind), ls.caustics.paths,
-                 formatSeconds(ls.caustics.seconds), ls.caustics.meanRadius);
-    if (method == lightcuts::Method::Brute)
-      fmt::print("method     brute force\n");
-    else
-      fmt::print("method     {} (tree {}: {} nodes, {:.1f} MiB, built in {}), error {}{}, max cut {}\n",
-                 lightcuts::methodName(method), lightcuts::treeBuilderName(tb.builder), forest.nodeCount(),
-                 double(forest.memoryBytes()) / (1 << 20), formatSeconds(forest.buildSeconds), error,
-                 method == lightcuts::Method::Lightcuts ? " (" + a.criterion + " criterion)" : "", a.maxCut);
-    fmt::print("image      {}x{}, {} spp{} -> {}\n", a.width, a.height, a.spp,
-               ro.spp == 1 && ro.aa == render::AntiAliasing::Adaptive
-                   ? fmt::format(", adaptive antialiasing: {} pixels ({:.1f}%) re-sampled {} times",
-                                 formatCount(double(rr.stats.aaPixels)),
-                                 100.0 * double(rr.stats.aaPixels) / (double(a.width) * double(a.height)), ro.aaSamples)
-                   : std::string(),
-               a.out);
-    if (distributed) {
-      std::string tiles, busy;
-      for (const auto& r : perRank) {
-        tiles += fmt::format("{}{}", tiles.empty() ? "" : " / ", r.at("tiles").get<uint64_t>());
-        busy += fmt::format("{}{:.2f}", busy.empty() ? "" : " / ", r.at("time_tiles_s").get<double>());
-      }
-      int threads = perRank[0].at("threads").get<int>();
-      fmt::print("mpi        {} ranks x {} thread{}: tiles {}, busy {} s; load balance {:.0f}%\n", cluster->size(),
-                 threads, threads == 1 ? "" : "s", tiles, busy, 100 * loadBalance);
-    }
-    if (ro.reconstructSpacing > 1)
-      fmt::print("recon.     full lightcuts every {} pixels ({} samples{}); {} points rebuilt from them, {} got full cuts\n",
-                 ro.reconstructSpacing, formatCount(double(rr.stats.reconstructionSamples)),
-                 ro.reconstructCoarseSpacing > 0
-                     ? fmt::format("; {} cells of {} kept whole where their samples agree",
-                                   formatCount(double(rr.stats.reconstructionCoarseCells)), ro.reconstructCoarseSpacing)
-                     : std::string(),
-                 formatCount(double(es.reconstructedPoints)), formatCount(double(rr.stats.reconstructionFallbacks)));
-    fmt::print("time       {} total: load {}, accel {}, lights {}, tree {}, render {}{}\n", formatSeconds(total),
-               formatSeconds(ls.loadSeconds), formatSeconds(ls.accelSeconds), formatSeconds(ls.lightSeconds),
-               formatSeconds(forest.buildSeconds), formatSeconds(rr.stats.seconds),
-               ref.pixels > 0 ? ", reference " + formatSeconds(ref.bruteSeconds) : std::string());
-    fmt::print("rays       {} primary, {} secondary, {} shadow ({} rays/s)\n", formatCount(double(rr.stats.primaryRays)),
-               formatCount(double(rr.stats.secondaryRays)), formatCount(double(es.shadowRays)),
-               formatCount(rr.stats.seconds > 0 ? double(allRays) / rr.stats.seconds : 0));
-    fmt::print("per point  {:.1f} lights (cut size), {:.1f} shadow rays, over {} shading points\n", perPoint,
-               raysPerPoint, formatCount(double(es.shadingPoints)));
-    if (ref.pixels > 0) {
-      double speedup = rr.stats.seconds > 0 ? ref.bruteSecondsEstimate / rr.stats.seconds : 0;
-      fmt::print("reference  brute force at {} pixels: {:.1f} lights per point; full image would take ~{} -> speed-up ~{:.1f}x\n",
-                 ref.pixels, ref.bruteLightsPerShadingPoint, formatSeconds(ref.bruteSecondsEstimate), speedup);
-      fmt::print("error      mean {:.2f}%, p99 {:.2f}%, max {:.2f}%, {:.2f}% of sampled pixels over 2%\n",
-                 100 * ref.meanRelativeError, 100 * ref.p99RelativeError, 100 * ref.maxRelativeError,
-                 100 * ref.fractionOver2pct);
-    }
-  }
+int renderJob(RenderArgs& a, Cluster* cluster) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RenderSetup s;
+  if (!setUpRender(a, cluster, s)) return interruptExitStatus();
+  RenderRun run;
+  if (std::optional<int> status = renderImage(a, cluster, s, run)) return *status;
+  reportRender(a, cluster, s, run, t0);
   return 0;
 }
 
@@ -748,11 +609,10 @@ void addRenderCommand(CLI::App& app) {
                             "default {}", d.estimator))
       ->check(CLI::IsMember({"first-order", "representative"}))
       ->group(cuts);
-  c->add_option("--visibility-probes", a->visibilityProbes,
-                fmt::format("Lightcuts: before refining a cluster whose representative is hidden, test the corners of "
-                            "its box; when one convex object hides them all, the cluster stays in the cut as hidden "
-                            "(on) or not (off, as published); default {}", d.visibilityProbes))
-      ->check(CLI::IsMember({"on", "off"}))
+  addSwitch(*c, "--visibility-probes", a->visibilityProbes,
+            fmt::format("Lightcuts: before refining a cluster whose representative is hidden, test the corners of "
+                        "its box; when one convex object hides them all, the cluster stays in the cut as hidden "
+                        "(on) or not (off, as published); default {}", switchName(d.visibilityProbes)))
       ->group(cuts);
   c->add_option("--reference-pixels", a->referencePixels,
                 fmt::format("Also run brute force at K pixels: report the measured error and the estimated "

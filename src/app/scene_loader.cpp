@@ -73,13 +73,13 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
     if (ir) {
       if (ir->vpls) v.count = *ir->vpls;
       if (ir->bounces) v.bounces = *ir->bounces;
-      if (ir->normalize) v.normalize = lights::parseVplNormalize(*ir->normalize);
+      if (ir->normalize) v.normalize = *ir->normalize;
       if (ir->clamp) v.clamp = *ir->clamp;
       if (ir->seed) v.seed = *ir->seed;
     }
     if (o.vplCount) v.count = *o.vplCount;
     if (o.bounces) v.bounces = *o.bounces;
-    if (o.vplNormalize) v.normalize = lights::parseVplNormalize(*o.vplNormalize);
+    if (o.vplNormalize) v.normalize = *o.vplNormalize;
     if (o.vplClamp) v.clamp = *o.vplClamp;
     if (o.vplSeed) v.seed = *o.vplSeed;
     v.maxVpls = o.limits.maxVpls;

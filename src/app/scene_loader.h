@@ -27,7 +27,7 @@ struct LoadOptions {
   lights::ObjectLightOptions objectLights;
   // Instant radiosity: command-line values override the scene's instant_radiosity block.
   std::optional<int> vplCount, bounces;
-  std::optional<std::string> vplNormalize;
+  std::optional<io::VplNormalize> vplNormalize;
   std::optional<float> vplClamp;
   // render --seed: overrides the scene's instant_radiosity seed when given; unset, the scene's
   // seed or VplOptions' default stands.

@@ -34,6 +34,13 @@ const char* nameOf(E value, std::initializer_list<std::pair<const char*, E>> nam
 
 }  // namespace
 
+const char* switchName(bool on) { return on ? "on" : "off"; }
+
+CLI::Option* addSwitch(CLI::App& c, const std::string& name, bool& value, const std::string& help) {
+  return c.add_option_function<std::string>(name, [&value](const std::string& v) { value = v == "on"; }, help)
+      ->check(CLI::IsMember({"on", "off"}));
+}
+
 void addSceneOptions(CLI::App& c, LoadOptions& o) {
   // Defaults as the loader sees them: o's own values, and VplOptions' and LightDesc's for
   // what o leaves unset (the scene's instant_radiosity block comes between).
@@ -43,8 +50,7 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
                                                   std::pair{"omni", lights::ObjectLightKind::Omni}});
   const char* placement = nameOf(o.objectLights.placement, {std::pair{"stratified", lights::Placement::Stratified},
                                                             std::pair{"seed", lights::Placement::Course}});
-  const char* normalize = nameOf(vpl.normalize, {std::pair{"power", lights::VplNormalize::Power},
-                                                 std::pair{"object", lights::VplNormalize::Object}});
+  const char* normalize = io::vplNormalizeName(vpl.normalize);
   const std::string lightsGroup = "Lights & GI";
   const std::string limitsGroup = "Limits";
 
@@ -98,10 +104,14 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
                              fmt::format("Instant radiosity: diffuse bounces; default the scene's, else {}", vpl.bounces))
       ->check(CLI::Range(0, 64))
       ->group(lightsGroup);
-  c.add_option_function<std::string>("--vpl-normalize", [&o](const std::string& v) { o.vplNormalize = v; },
+  // The names, checked here once, and the values: io::VplNormalize (io/scene_desc.h).
+  std::vector<std::string> normalizeNames;
+  for (const auto& [value, name] : io::kVplNormalizeNames) normalizeNames.emplace_back(name);
+  c.add_option_function<std::string>("--vpl-normalize",
+                                     [&o](const std::string& v) { o.vplNormalize = io::parseVplNormalize(v); },
                                      fmt::format("VPL intensities: power (energy conserving) or object (the seed's "
                                                  "per-object division); default the scene's, else {}", normalize))
-      ->check(CLI::IsMember({"power", "object"}))
+      ->check(CLI::IsMember(normalizeNames))
       ->group(lightsGroup);
   c.add_option_function<float>("--vpl-clamp", [&o](const float& v) { o.vplClamp = v; },
                                fmt::format("VPL distance clamp, as a fraction of half the scene diagonal; default the "
@@ -132,9 +142,7 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
                                            lights::CausticOptions{}.smoothing))
       ->check(CLI::Range(1e-3f, 1e3f))
       ->group(lightsGroup);
-  c.add_option_function<std::string>("--gi", [&o](const std::string& v) { o.gi = v == "on"; },
-                                     fmt::format("Global illumination from VPLs: on or off; default {}", o.gi ? "on" : "off"))
-      ->check(CLI::IsMember({"on", "off"}))
+  addSwitch(c, "--gi", o.gi, fmt::format("Global illumination from VPLs: on or off; default {}", switchName(o.gi)))
       ->group(lightsGroup);
   c.add_option("--max-lights", o.limits.maxLights,
                fmt::format("Limit on lights (object lights, VPLs and scene lights); default {}", o.limits.maxLights))

@@ -41,7 +41,7 @@ std::vector<double> relErrors(const Image& ref, const Image& test, double floor)
   std::vector<double> e(ref.pixels.size());
   for (size_t i = 0; i < e.size(); ++i) {
     double lr = lum(ref.pixels[i]), lt = lum(test.pixels[i]);
-    e[i] = finiteOrInf(std::fabs(lt - lr) / std::max(lr, floor));
+    e[i] = finiteOrInf(relativeError(lr, lt, floor));
   }
   return e;
 }
@@ -86,8 +86,8 @@ ImageMetrics compareImages(const Image& ref, const Image& test, double relThresh
   m.mean_relative_error = sumRel / double(n);
   m.fraction_over_threshold = double(over) / double(n);
   m.threshold = relThreshold;
-  // Nearest rank: the ceil(0.99 n)-th smallest, in integers to avoid 0.99*n rounding.
-  size_t rank = (99 * n + 99) / 100;
+  // Nearest rank: the ceil(0.99 n)-th smallest.
+  size_t rank = p99Rank(n);
   std::nth_element(e.begin(), e.begin() + long(rank - 1), e.end());
   m.p99_relative_error = e[rank - 1];
   return m;

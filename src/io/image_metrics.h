@@ -22,6 +22,9 @@
 // A NaN or infinite difference counts as an infinite error (it is never skipped).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -30,6 +33,16 @@
 namespace lc::io {
 
 constexpr double kMinRelativeFloor = 1e-6;
+
+// rel(p) from the pixel's reference and test luminances and the floor (as defined above;
+// the reference pixels of a render, render/reference_pixels.cpp, use it too).
+inline double relativeError(double refLum, double testLum, double floor) {
+  return std::fabs(testLum - refLum) / std::max(refLum, floor);
+}
+
+// The rank (1-based, in ascending order) of the 99th percentile of n >= 1 values, nearest
+// rank: ceil(0.99 n), in integers so that 0.99 n does not round.
+inline size_t p99Rank(size_t n) { return (99 * n + 99) / 100; }
 
 struct ImageMetrics {
   double rmse = 0;

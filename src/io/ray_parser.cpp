@@ -947,9 +947,9 @@ void Parser::instantRadiosity(const Token& kw) {
       ir.bounces = int(integerValue("bounces", 1000));
     } else if (w == "normalize") {
       Token t = lex_.next();
-      if (t.kind != TokenKind::Ident || (t.text != "power" && t.text != "object"))
-        expected("\"power\" or \"object\" for normalize", t);
-      ir.normalize = t.text;
+      std::optional<VplNormalize> v = t.kind == TokenKind::Ident ? findVplNormalize(t.text) : std::nullopt;
+      if (!v) expected(vplNormalizeChoices("\"") + " for normalize", t);
+      ir.normalize = *v;
     } else if (w == "clamp") {
       ir.clamp = nonNegative("clamp");
     } else if (w == "seed") {

@@ -1170,12 +1170,12 @@ TEST(RayParserInstantRadiosity, AllFields) {
   const InstantRadiosityDesc& ir = *s.instantRadiosity;
   EXPECT_EQ(*ir.vpls, 10000);
   EXPECT_EQ(*ir.bounces, 2);
-  EXPECT_EQ(*ir.normalize, "object");
+  EXPECT_EQ(*ir.normalize, VplNormalize::Object);
   EXPECT_EQ(*ir.clamp, 0.05f);
   EXPECT_EQ(*ir.seed, 18446744073709551615ull);
   EXPECT_EQ(ir.loc.line, 2);
   SceneDesc t = parse("instant_radiosity { normalize = power; }\ninstant_radiosity { vpls = 1e3; }");
-  EXPECT_EQ(*t.instantRadiosity->normalize, "power");
+  EXPECT_EQ(*t.instantRadiosity->normalize, VplNormalize::Power);
   EXPECT_EQ(*t.instantRadiosity->vpls, 1000);
   EXPECT_FALSE(t.instantRadiosity->bounces);
 }

@@ -229,7 +229,7 @@ class Writer {
     if (ir.bounces) out_ += "  bounces = " + std::to_string(*ir.bounces) + ";\n";
     if (ir.normalize) {
       out_ += "  normalize = ";
-      quoted(sanitizeName(*ir.normalize));
+      quoted(vplNormalizeName(*ir.normalize));
       out_ += ";\n";
     }
     if (ir.clamp) line("  ", "clamp", *ir.clamp);

@@ -7,6 +7,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/error.h"
@@ -129,11 +131,27 @@ struct LightDesc {
   SourceLoc loc;
 };
 
+// How VPL intensities are normalised: instant_radiosity's `normalize`, --vpl-normalize,
+// lights::VplOptions::normalize (applied in lights/vpl.cpp). Its one definition, with its
+// names, here in the scene description: the parser, the CLI and the VPLs all read it.
+enum class VplNormalize {
+  Power,   // energy conserving: each path carries its light's power / number of paths (default)
+  Object,  // the seed's: a VPL's intensity divided by the number of VPLs on its object
+};
+// Each value and its name ("power", "object"), in the order the help and messages list them.
+inline constexpr std::pair<VplNormalize, const char*> kVplNormalizeNames[] = {{VplNormalize::Power, "power"},
+                                                                             {VplNormalize::Object, "object"}};
+const char* vplNormalizeName(VplNormalize v);
+std::optional<VplNormalize> findVplNormalize(std::string_view name);  // none for another name
+VplNormalize parseVplNormalize(const std::string& name);  // throws lc::Error for another name
+// The names joined by " or ", each in `quote` ("power or object", "\"power\" or \"object\"").
+std::string vplNormalizeChoices(const char* quote = "");
+
 // instant_radiosity { vpls; bounces; normalize; clamp; seed; caustics; caustic_lights; }  (command line overrides)
 struct InstantRadiosityDesc {
   std::optional<int> vpls;
   std::optional<int> bounces;
-  std::optional<std::string> normalize;  // "power" | "object"
+  std::optional<VplNormalize> normalize;
   std::optional<float> clamp;
   std::optional<uint64_t> seed;
   std::optional<int> caustics;                // light paths for caustic lights (lights/caustics.h)

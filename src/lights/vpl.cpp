@@ -38,12 +38,6 @@
 
 namespace lc::lights {
 
-VplNormalize parseVplNormalize(const std::string& s) {
-  if (s == "power") return VplNormalize::Power;
-  if (s == "object") return VplNormalize::Object;
-  throw Error("unknown VPL normalisation '" + s + "' (use power or object)");
-}
-
 namespace {
 
 struct Deposit {

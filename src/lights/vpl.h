@@ -9,15 +9,14 @@
 
 #include "core/progress.h"
 #include "core/rng.h"
+#include "io/scene_desc.h"
 #include "scene/scene.h"
 
 namespace lc::lights {
 
-enum class VplNormalize {
-  Power,   // energy conserving: each path carries its light's power / number of paths (default)
-  Object,  // the seed's: a VPL's intensity divided by the number of VPLs on its object
-};
-VplNormalize parseVplNormalize(const std::string& s);
+// The values, their names and their parsing: io/scene_desc.h (the scene's
+// instant_radiosity block and --vpl-normalize share them).
+using io::VplNormalize;
 
 struct VplOptions {
   int count = 0;       // --vpls: paths shot (VPLs deposited can differ with bounces)

@@ -1,6 +1,7 @@
-// Adaptive antialiasing, the parts that do not trace: which pixels of a tile to re-sample
-// (their centre samples disagree with a neighbour's: RenderOptions::aa*, renderer.h) and
-// where the sub-samples go. The renderer traces them (renderer.cpp, adaptiveTile).
+// Adaptive antialiasing (RenderOptions::aa*, renderer.h): which pixels of a tile to
+// re-sample (their centre samples disagree with a neighbour's), where the sub-samples go,
+// and tracing them (adaptiveTile, after a tile's centre samples; pixelWithSubSamples for
+// the reference pixels). The first parts do not trace, so they are tested alone.
 #pragma once
 
 #include <cstdint>
@@ -8,7 +9,10 @@
 
 #include "core/math.h"
 #include "core/rng.h"
+#include "lightcuts/evaluator.h"
 #include "render/renderer.h"
+#include "render/tracer.h"
+#include "scene/scene.h"
 
 namespace lc::render {
 
@@ -40,5 +44,23 @@ Vec2 aaSubSamplePosition(int s, int g, Rng& rng);
 inline uint64_t aaStream(int x, int y, int width, int height) {
   return uint64_t(width) * uint64_t(height) + uint64_t(y) * uint64_t(width) + uint64_t(x);
 }
+
+class ReconstructionTile;
+struct AaCutCache;
+
+// The tile `rect` after its centre samples: flags the pixels whose centres disagree with a
+// neighbour's and re-samples them, counting in `counters`. Every input is the tile's own
+// (its pixels, its samples, centre rays probed around it), so the result does not depend
+// on the order tiles run in. Under reconstruction cuts (rt, with its cache of merged cuts)
+// the sub-samples borrow from the tile's samples (ReconstructionTile::subSampleHook).
+void adaptiveTile(const scene::Scene& scene, const lightcuts::LightEvaluator& ev, const RenderOptions& o,
+                  RenderResult& res, TileCounters& counters, const TileRect& rect, const ReconstructionTile* rt,
+                  AaCutCache* cache);
+
+// A pixel as the render made it, with another evaluator (brute force for the reference
+// pixels, apples to apples): the centre sample, and where antialiasing re-sampled the
+// pixel, the same sub-samples (same positions), each with a full evaluation.
+Color pixelWithSubSamples(const scene::Scene& scene, const lightcuts::LightEvaluator& ev, const RenderOptions& o,
+                          const RenderResult& res, int x, int y, lightcuts::EvalStats& stats);
 
 }  // namespace lc::render

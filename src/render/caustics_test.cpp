@@ -14,6 +14,7 @@
 #include "lightcuts/evaluator.h"
 #include "lightcuts/light_tree.h"
 #include "render/renderer.h"
+#include "render/tracer.h"
 
 namespace lc {
 namespace {

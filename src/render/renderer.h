@@ -67,7 +67,7 @@ struct RenderOptions {
   // Larger cells first (a multiple of reconstructSpacing by a power of two; 0 = none): a
   // cell of this size is rebuilt from its four corner samples when they lie on one surface
   // and the nodes of their merged cut they disagree about hold little of its light (see
-  // kCoarseMaxDisagreement in renderer.cpp); otherwise it splits down to
+  // kCoarseMaxDisagreement in reconstruction_tiles.h); otherwise it splits down to
   // reconstructSpacing (and below, where pixels are not served).
   int reconstructCoarseSpacing = 0;
   // Luminance floor of lightcuts' relative error criterion (ShadingPoint::errorFloor): a
@@ -190,13 +190,6 @@ class WorkShare {
 RenderResult render(const scene::Scene& scene, const lightcuts::LightEvaluator& evaluator,
                     const RenderOptions& options);
 
-// Fraction of the VPLs' direct contribution that their distance clamp removes, measured
-// exactly (with visibility) at primary hits of up to `points` pixels spread over the image,
-// fewer when the scene has so many VPLs that points x VPLs would exceed `maxEvaluations`.
-// 0 when the scene has no VPLs.
-double vplClampedFraction(const scene::Scene& scene, const RenderOptions& options, int points = 256,
-                          uint64_t maxEvaluations = 2'000'000);
-
 // Per-pixel auxiliary outputs (AOVs) at the pixel centre's primary hit: the material's
 // diffuse colour (albedo, texture applied), the shading normal (world space) and the
 // distance along the camera ray (depth); a ray that hits nothing gives 0, 0 and +inf.
@@ -206,9 +199,5 @@ struct PixelAovs {
   std::vector<float> depth;
 };
 PixelAovs primaryAovs(const scene::Scene& scene, const RenderOptions& options);
-
-// Radiance along one camera ray (exposed for tests).
-Color traceRay(const scene::Scene& scene, const lightcuts::LightEvaluator& evaluator, const scene::Ray& ray,
-               int maxDepth, lightcuts::EvalStats& stats);
 
 }  // namespace lc::render

@@ -1,0 +1,195 @@
+#include "render/tracer.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <time.h>
+
+#include "core/rng.h"
+
+namespace lc::render {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+uint64_t threadCpuNanos() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return uint64_t(ts.tv_sec) * 1'000'000'000u + uint64_t(ts.tv_nsec);
+}
+
+// Sample s of spp inside a pixel: stratified on a near-square grid, jittered; a single
+// sample takes the pixel centre.
+Vec2 samplePosition(int s, int spp, Rng& rng) {
+  if (spp <= 1) return Vec2(0.5f, 0.5f);
+  int gx = int(std::ceil(std::sqrt(double(spp))));
+  int gy = (spp + gx - 1) / gx;
+  int ix = s % gx, iy = s / gx;
+  return Vec2((float(ix) + rng.uniform()) / float(gx), (float(iy) + rng.uniform()) / float(gy));
+}
+
+}  // namespace
+
+Color ShadowRays::operator()(const Vec3& wi, float dist) {
+  return timed([&] {
+    float tmax;
+    Vec3 o = origin(wi, dist, tmax);
+    if (!(tmax > 0)) return Color(1);
+    return scene_.transmittance(o, wi, tmax);
+  });
+}
+
+Color ShadowRays::trace(const Vec3& wi, float dist, int& blocker, float& tHit) {
+  return timed([&] {
+    float tmax;
+    Vec3 o = origin(wi, dist, tmax);
+    blocker = kVisible;
+    tHit = 0;
+    if (!(tmax > 0)) return Color(1);
+    int shape = scene_.firstHit(o, wi, tmax, tHit);
+    if (shape < 0) return Color(1);
+    if (scene_.isTransmissive(shape)) {  // glass on the way: the walk through it decides
+      Color v = scene_.transmittance(o, wi, tmax);
+      blocker = isBlack(v) ? kUnknownBlocker : kVisible;
+      return v;
+    }
+    blocker = scene_.isConvex(shape) ? shape : kUnknownBlocker;
+    return Color(0);
+  });
+}
+
+// The ray's origin, off the surface on the light's side and a step toward the light,
+// and its length to just short of the light. The step matters on an edge where two
+// surfaces meet (a room's corner): the point lies in the other surface's plane, and
+// watertight hits (issue 29) would count that surface at t = 0 and shadow the edge.
+Vec3 ShadowRays::origin(const Vec3& wi, float dist, float& tmax) const {
+  tmax = std::isinf(dist) ? kInf : dist - 3 * eps_;
+  return p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_) + wi * eps_;
+}
+
+template <class F>
+Color ShadowRays::timed(const F& f) {
+  if (!stats_) return f();
+  ++stats_->tracedRays;
+  static thread_local uint64_t state = 0x9e3779b97f4a7c15ull;
+  state ^= state << 13, state ^= state >> 7, state ^= state << 17;  // xorshift64
+  if (state % kTimedRayOdds != 0) return f();
+  // t1 - t0 is one clock read: taken off the ray's interval, which holds one too.
+  auto t0 = Clock::now(), t1 = Clock::now();
+  Color c = f();
+  auto t2 = Clock::now();
+  const int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>((t2 - t1) - (t1 - t0)).count();
+  if (ns <= kMaxTimedRayNs) {
+    ++stats_->timedRays;
+    stats_->timedRayNanos += uint64_t(std::max<int64_t>(ns, 0));
+  }
+  return c;
+}
+
+lightcuts::EvalResult Tracer::directLight(const scene::Hit& h, const lightcuts::ShadingPoint& sp, int depth) {
+  ++stats.litPoints;
+  static thread_local uint64_t state = 0x2545f4914f6cdd1dull;
+  state ^= state << 13, state ^= state >> 7, state ^= state << 17;  // xorshift64
+  if (state % kTimedPointOdds != 0) return evaluateLight(h, sp, depth);
+  const uint64_t t0 = threadCpuNanos();
+  lightcuts::EvalResult r = evaluateLight(h, sp, depth);
+  stats.lightingNanos += threadCpuNanos() - t0;
+  ++stats.timedPoints;
+  return r;
+}
+
+lightcuts::EvalResult Tracer::evaluateLight(const scene::Hit& h, const lightcuts::ShadingPoint& sp, int depth) {
+  ShadowRays vis(scene, h, &stats);
+  if (depth > 0 || !hook) return evaluator.evaluate(sp, vis, stats);
+  return hook->light(h, sp, vis, stats);
+}
+
+Color Tracer::trace(const scene::Ray& ray, int depth, float weight) {
+  scene::Hit h;
+  // A ray that escapes sees the environment (camera, reflected and refracted rays alike).
+  if (!scene.intersect(ray, h)) return scene.background(normalize(ray.d));
+  scene::ShadingMaterial m = scene.shadingMaterial(h);
+  Color L = m.ke + m.ka * scene.ambient();
+  Vec3 v = -normalize(ray.d);
+  if (!isBlack(m.kd) || !isBlack(m.ks)) {
+    lightcuts::ShadingPoint sp;
+    sp.p = h.p;
+    sp.n = h.ns;
+    sp.r = normalize(reflect(v, h.ns));
+    sp.kd = m.kd;
+    sp.ks = m.ks;
+    sp.shininess = m.shininess;
+    sp.errorFloor = errorFloor > 0 && weight > 0 ? errorFloor / weight : 0;
+    lightcuts::EvalResult r = directLight(h, sp, depth);
+    L += r.radiance;
+    cutNodes += r.cutSize;
+  }
+  if (depth >= maxDepth) return L;
+  if (!isBlack(m.kr)) {
+    Vec3 r = normalize(reflect(v, h.ns));
+    // A non-finite direction (NaN normal, extreme values) is dropped, not traced.
+    if (isFinite(r)) {
+      ++secondaryRays;
+      L += m.kr * trace(scene::Ray{scene.offsetOrigin(h, r), r, 0, kInf}, depth + 1, weight * luminance(m.kr));
+    }
+  }
+  if (!isBlack(m.kt)) {
+    // Entering through the front face goes from air (index 1) into the material.
+    float eta = h.frontFace ? 1.0f / m.ior : m.ior;
+    float cosI = std::min(1.0f, dot(v, h.ns));
+    float sin2T = eta * eta * (1 - cosI * cosI);
+    Vec3 t;
+    // (written so that a NaN sin2T, e.g. inf * 0 for a huge index, is total reflection)
+    if (!(sin2T < 1)) {
+      t = normalize(reflect(v, h.ns));  // total internal reflection
+    } else {
+      t = normalize(-v * eta + h.ns * (eta * cosI - std::sqrt(1 - sin2T)));
+    }
+    // A refracted ray with a non-finite direction is dropped, not traced.
+    if (isFinite(t)) {
+      ++secondaryRays;
+      L += m.kt * trace(scene::Ray{scene.offsetOrigin(h, t), t, 0, kInf}, depth + 1, weight * luminance(m.kt));
+    }
+  }
+  return L;
+}
+
+Color traceRay(const scene::Scene& scene, const lightcuts::LightEvaluator& evaluator, const scene::Ray& ray,
+               int maxDepth, lightcuts::EvalStats& stats) {
+  Tracer tr{scene, evaluator, maxDepth, stats};
+  return tr.trace(ray, 0);
+}
+
+PixelResult renderPixel(const scene::Scene& scene, const lightcuts::LightEvaluator& ev, const RenderOptions& o, int x,
+                        int y, lightcuts::EvalStats& stats, uint64_t& primary, uint64_t& secondary,
+                        PrimaryLight* hook) {
+  Rng rng(o.seed, uint64_t(y) * uint64_t(o.width) + uint64_t(x));
+  const uint64_t rays0 = stats.shadowRays;
+  Tracer tr{scene, ev, o.maxDepth, stats, hook};
+  tr.errorFloor = std::max(0.0f, o.errorFloor);
+  Color sum(0);
+  const scene::Camera& cam = scene.camera();
+  for (int s = 0; s < o.spp; ++s) {
+    Vec2 u = samplePosition(s, o.spp, rng);
+    float sx = (float(x) + u.x) / float(o.width), sy = (float(y) + u.y) / float(o.height);
+    scene::Ray ray{cam.eye, normalize(cam.direction(sx, sy)), 0, kInf};
+    ++primary;
+    Color c = tr.trace(ray, 0);
+    if (!isFinite(c)) c = Color(0);  // never let a NaN reach the image
+    sum += c;
+  }
+  secondary += tr.secondaryRays;
+  return {sum / float(o.spp), float(tr.cutNodes) / float(o.spp), float(stats.shadowRays - rays0) / float(o.spp)};
+}
+
+void storePixel(RenderResult& res, int width, int x, int y, const PixelResult& p) {
+  size_t i = size_t(y) * size_t(width) + size_t(x);
+  res.image.pixels[i] = p.color;
+  res.cutSize[i] = p.cut;
+  res.shadowRays[i] = p.shadowRays;
+  res.done[i] = 1;
+}
+
+}  // namespace lc::render
