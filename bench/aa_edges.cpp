@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
       side.at(x, y) = test.at(x0 + x, y0 + y);
       side.at(w + x, y) = ref.at(x, y);
     }
-  size_t edges = 0, under = 0, geometric = 0, flat = 0, flatUnder = 0;
+  size_t edges = 0, under = 0, geometric = 0, geoUnder = 0, flat = 0, flatUnder = 0;
+  const bool list = std::getenv("AA_EDGES_LIST") != nullptr;  // print each geometric edge pixel over 2%
   double sum = 0;
   std::vector<double> errs;
   for (int y = 0; y < h; ++y)
@@ -81,6 +82,9 @@ int main(int argc, char** argv) {
       errs.push_back(e);
       sum += e;
       under += e < 0.02;
+      geoUnder += geo && e < 0.02;
+      if (list && geo && e >= 0.02)
+        std::printf("over: %d %d ref %.4f test %.4f err %.2f%%\n", x, y, r, t, 100 * e);
     }
   std::sort(errs.begin(), errs.end());
   const double p99 = errs.empty() ? 0 : errs[std::min(errs.size() - 1, size_t(0.99 * double(errs.size())))];
@@ -89,6 +93,9 @@ int main(int argc, char** argv) {
               edges ? 100 * sum / double(edges) : 0.0,
               errs.empty() ? 0.0 : 100 * errs[std::min(errs.size() - 1, size_t(0.95 * double(errs.size())))],
               100 * p99);
+  std::printf("geometric edge pixels under 2%%: %.2f%%; contrast-only: %.2f%% of %zu\n",
+              geometric ? 100.0 * double(geoUnder) / double(geometric) : 100.0,
+              edges > geometric ? 100.0 * double(under - geoUnder) / double(edges - geometric) : 100.0, edges - geometric);
   std::printf("other pixels %zu; under 2%%: %.2f%%\n", flat, flat ? 100.0 * double(flatUnder) / double(flat) : 100.0);
   if (argc == 6) io::writeImage(argv[5], side, io::ToneMap::Srgb);
   return 0;

@@ -1449,7 +1449,7 @@ TEST(CliOutput, AdaptiveAntialiasingByDefault) {
   EXPECT_EQ(d["aa"], "adaptive");
   EXPECT_GT(d["aa_pixels"].get<int>(), 20);  // the sphere's outline
   EXPECT_LT(d["aa_pixels"].get<int>(), 32 * 32 / 2);
-  EXPECT_EQ(d["primary_rays"].get<int>(), 32 * 32 + 8 * d["aa_pixels"].get<int>());
+  EXPECT_EQ(d["primary_rays"].get<int>(), 32 * 32 + 48 * d["aa_pixels"].get<int>());
   nlohmann::json off = stats({"--aa", "off"});
   EXPECT_EQ(off["aa_pixels"].get<int>(), 0);
   EXPECT_EQ(off["primary_rays"].get<int>(), 32 * 32);

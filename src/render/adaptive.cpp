@@ -65,35 +65,168 @@ struct SubSampleSums {
   Color color{0};
   double cut = 0, shadowRays = 0;
   int count = 0;
+  int shaded = 0;  // of them, those shaded (the others took a shaded one's radiance)
   uint64_t fallbacks = 0;  // sub-samples no reconstruction sample could serve
 };
 
+float dist2(const Vec2& a, const Vec2& b) { return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y); }
+
+// Whether a hit on this material must be shaded at every sub-sample: a mirror or glass
+// shows other surfaces, a texture varies within the pixel.
+bool shadeEverySubSample(const scene::Material& m) {
+  return !m.reflective.isBlack() || !m.transmissive.isBlack() || m.diffuse.texture || m.specular.texture ||
+         m.emissive.texture || m.ambient.texture || m.shininess.texture;
+}
+
 // The sub-samples of pixel (x, y) on the g x g grid; under reconstruction cuts (rt) each
 // borrows from the tile's samples (ReconstructionTile::subSampleHook).
+//
+// Coverage and shading are decoupled (as MSAA and Ragan-Kelley et al. 2011 do): every
+// sub-sample's primary ray finds which surface it sees, but on a plain diffuse or glossy
+// surface only the first sub-sample of that surface in each cell of a 3 x 3 grid over the
+// pixel is shaded, and the others take the radiance of the nearest shaded one on the same
+// surface (a shape and a normal within aaNormalCos; the pixel's centre, `centre`, counts as
+// shaded). An edge
+// pixel's error is mostly which surface covers how much of it, which 48 rays measure for
+// the price of a few shadings; light varies little across one surface within a pixel.
 SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightEvaluator& ev, const RenderOptions& o,
                               int x, int y, int g, lightcuts::EvalStats& stats, uint64_t& primary,
-                              uint64_t& secondary, const ReconstructionTile* rt, AaCutCache* cache) {
+                              uint64_t& secondary, const ReconstructionTile* rt, AaCutCache* cache,
+                              int centreShape, const Vec3& centreNormal, const Color& centre) {
   SubSampleSums sums;
   Rng rng(o.seed, aaStream(x, y, o.width, o.height));
   const scene::Camera& cam = scene.camera();
-  for (int s = 0; s < g * g - 1; ++s) {
-    Vec2 u = aaSubSamplePosition(s, g, rng);
-    scene::Ray ray{cam.eye,
-                   normalize(cam.direction((float(x) + u.x) / float(o.width), (float(y) + u.y) / float(o.height))), 0,
-                   kInf};
+  const int n = g * g - 1;
+  struct Sub {
+    Vec2 u;
+    scene::Ray ray;
+    int shape = -1;
+    int surface = -1;  // index into `surfaces`
+    bool shade = true;
+    Color c{0};
+  };
+  static thread_local std::vector<Sub> subs;
+  subs.assign(size_t(n), Sub{});
+  // Which surface each sub-sample sees, and which of them are shaded.
+  const bool decouple = o.aaDecoupled && g > 3;
+  // The surfaces the sub-samples see, the centre's first: hits on one tangent plane (normals
+  // within aaNormalCos, the point within 1% of the distance of the plane) with the same
+  // material values, or misses. Not the shape index: how a scene is cut into shapes (an OBJ
+  // read directly or converted) must not change the image. Per cell of the 3 x 3 grid, the
+  // surfaces already given a shading sample there.
+  struct Surface {
+    bool hit;
+    Vec3 p, n;
+    float t;
+    const scene::Material* m;
+  };
+  std::vector<Surface> surfaces;
+  {
+    scene::Hit h;
+    const scene::Ray c{cam.eye, normalize(cam.direction((float(x) + 0.5f) / float(o.width), (float(y) + 0.5f) / float(o.height))),
+                       0, kInf};
+    const bool hit = centreShape >= 0 && scene.intersect(c, h);
+    surfaces.push_back(Surface{hit, h.p, h.ns, h.t, hit ? &scene.materialOf(h) : nullptr});
+  }
+  auto same = [&](const Surface& a, bool hit, const scene::Hit& h, const scene::Material* m) {
+    if (a.hit != hit) return false;
+    if (!hit) return true;
+    return dot(a.n, h.ns) >= o.aaNormalCos && std::fabs(dot(h.p - a.p, a.n)) <= 0.01f * a.t &&
+           (a.m == m || (a.m->diffuse.value == m->diffuse.value && a.m->specular.value == m->specular.value &&
+                         a.m->emissive.value == m->emissive.value && a.m->ambient.value == m->ambient.value &&
+                         a.m->shininess.value == m->shininess.value));
+  };
+  std::vector<std::pair<int, int>> shadedInCell;  // (cell, surface)
+  if (decouple) shadedInCell.emplace_back(4, 0);  // the centre sample
+  for (int s = 0; s < n; ++s) {
+    Sub& b = subs[size_t(s)];
+    b.u = aaSubSamplePosition(s, g, rng);
+    b.ray = scene::Ray{cam.eye,
+                       normalize(cam.direction((float(x) + b.u.x) / float(o.width), (float(y) + b.u.y) / float(o.height))),
+                       0, kInf};
+    if (!decouple) continue;
+    scene::Hit hit;
+    if (scene.intersect(b.ray, hit)) b.shape = hit.shape;
+    ++primary;
+    const scene::Material* m = b.shape >= 0 ? &scene.materialOf(hit) : nullptr;
+    for (size_t k = 0; k < surfaces.size() && b.surface < 0; ++k)
+      if (same(surfaces[k], b.shape >= 0, hit, m)) b.surface = int(k);
+    if (b.surface < 0) {
+      b.surface = int(surfaces.size());
+      surfaces.push_back(Surface{b.shape >= 0, hit.p, hit.ns, hit.t, m});
+    }
+    if (b.shape >= 0 && shadeEverySubSample(scene.materialOf(hit))) continue;
+    const int cell = std::min(2, int(b.u.x * 3)) + 3 * std::min(2, int(b.u.y * 3));
+    const std::pair<int, int> key{cell, b.surface};
+    if (std::find(shadedInCell.begin(), shadedInCell.end(), key) != shadedInCell.end()) {
+      b.shade = false;
+    } else {
+      shadedInCell.push_back(key);
+    }
+  }
+  // Shades sub-sample b (a full trace from its primary ray).
+  auto shade = [&](Sub& b) {
     PrimaryHook hook;
     const CutSample* chosen[4];
-    if (rt) rt->subSampleHook(ray, x, y, u, hook, chosen, *cache);
+    if (rt) rt->subSampleHook(b.ray, x, y, b.u, hook, chosen, *cache);
     Tracer tr{scene, ev, o.maxDepth, stats, rt ? &hook : nullptr};
     const uint64_t rays0 = stats.shadowRays;
-    ++primary;
-    Color c = tr.trace(ray, 0);
+    if (!decouple) ++primary;
+    Color c = tr.trace(b.ray, 0);
     if (!isFinite(c)) c = Color(0);
-    sums.color += c;
+    b.c = c;
     sums.cut += double(tr.cutNodes);
     sums.shadowRays += double(stats.shadowRays - rays0);
     secondary += tr.secondaryRays;
     sums.fallbacks += hook.fallbacks;
+    ++sums.shaded;
+  };
+  for (Sub& b : subs)
+    if (b.shade) shade(b);
+  if (decouple) {
+    // A surface whose shaded samples disagree (a hard shadow's edge, a highlight crosses the
+    // pixel) is shaded at every sub-sample after all: coverage alone does not measure it.
+    for (size_t k = 0; k < shadedInCell.size(); ++k) {
+      const int surface = shadedInCell[k].second;
+      bool seen = false;
+      for (size_t j = 0; j < k; ++j) seen |= shadedInCell[j].second == surface;
+      if (seen) continue;
+      float lo = kInf, hi = 0;
+      if (surface == 0) lo = hi = luminance(centre);
+      bool pending = false;
+      for (const Sub& b : subs) {
+        if (b.surface != surface) continue;
+        pending |= !b.shade;
+        if (!b.shade) continue;
+        lo = std::min(lo, luminance(b.c));
+        hi = std::max(hi, luminance(b.c));
+      }
+      if (pending && hi - lo > o.aaShadingSpread * std::max(hi, o.aaContrastFloor))
+        for (Sub& b : subs)
+          if (b.surface == surface && !b.shade) {
+            b.shade = true;
+            shade(b);
+          }
+    }
+  }
+  for (int s = 0; s < n; ++s) {
+    Sub& b = subs[size_t(s)];
+    if (!b.shade) {
+      // The nearest shaded sub-sample on the same surface (the centre included).
+      float best = kInf;
+      Color c = centre;
+      if (b.surface == 0) best = dist2(b.u, Vec2(0.5f, 0.5f));
+      for (const Sub& o2 : subs)
+        if (o2.shade && o2.surface == b.surface) {
+          const float d = dist2(b.u, o2.u);
+          if (d < best) {
+            best = d;
+            c = o2.c;
+          }
+        }
+      b.c = c;
+    }
+    sums.color += b.c;
     ++sums.count;
   }
   return sums;
@@ -139,12 +272,15 @@ void adaptiveTile(const scene::Scene& scene, const lightcuts::LightEvaluator& ev
     for (int x = x0; x < x1; ++x) {
       if (!flags[size_t(y - y0) * size_t(w) + size_t(x - x0)]) continue;
       if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
-      SubSampleSums sub =
-          traceSubSamples(scene, ev, o, x, y, g, counters.stats, counters.primary, counters.secondary, rt, cache);
       size_t i = size_t(y) * size_t(o.width) + size_t(x);
+      const CentreSample& cs = ring[size_t(y - y0 + 1) * size_t(w + 2) + size_t(x - x0 + 1)];
+      SubSampleSums sub = traceSubSamples(scene, ev, o, x, y, g, counters.stats, counters.primary,
+                                          counters.secondary, rt, cache, cs.shape, cs.n, res.image.pixels[i]);
       res.image.pixels[i] = (res.image.pixels[i] + sub.color) / n;
-      res.cutSize[i] = float((double(res.cutSize[i]) + sub.cut) / double(n));
-      res.shadowRays[i] = float((double(res.shadowRays[i]) + sub.shadowRays) / double(n));
+      // Per shading: the samples that took another's radiance cost no cut.
+      const double shadings = 1.0 + sub.shaded;
+      res.cutSize[i] = float((double(res.cutSize[i]) + sub.cut) / shadings);
+      res.shadowRays[i] = float((double(res.shadowRays[i]) + sub.shadowRays) / shadings);
       res.aaFlagged[i] = 1;
       ++counters.aaPixels;
       counters.aaSubSamples += uint64_t(sub.count);
@@ -158,7 +294,12 @@ Color pixelWithSubSamples(const scene::Scene& scene, const lightcuts::LightEvalu
   Color c = renderPixel(scene, ev, o, x, y, stats, a, b).color;
   if (!res.aaFlagged[size_t(y) * size_t(o.width) + size_t(x)]) return c;
   const int g = aaGridSide(o.aaSamples);
-  SubSampleSums sub = traceSubSamples(scene, ev, o, x, y, g, stats, a, b, nullptr, nullptr);
+  const scene::Camera& cam = scene.camera();
+  scene::Ray ray{cam.eye, normalize(cam.direction((float(x) + 0.5f) / float(o.width), (float(y) + 0.5f) / float(o.height))),
+                 0, kInf};
+  scene::Hit hit;
+  const int centreShape = scene.intersect(ray, hit) ? hit.shape : -1;
+  SubSampleSums sub = traceSubSamples(scene, ev, o, x, y, g, stats, a, b, nullptr, nullptr, centreShape, hit.ns, c);
   return (c + sub.color) / float(g * g);
 }
 

@@ -50,10 +50,17 @@ struct RenderOptions {
   // is their mean. Sub-samples borrow the tile's reconstruction samples where they lie on
   // the same surface (else a full lightcut). Measured on the demo (docs/LIGHTCUTS.md).
   AntiAliasing aa = AntiAliasing::Adaptive;
-  int aaSamples = 8;             // g^2 - 1 for odd g: 8 (3 x 3), 24 (5 x 5) or 48 (7 x 7)
+  int aaSamples = 48;            // g^2 - 1 for odd g: 8 (3 x 3), 24 (5 x 5) or 48 (7 x 7)
   float aaContrast = 0.25f;      // relative luminance contrast that flags a pixel (docs/LIGHTCUTS.md)
   float aaContrastFloor = 0.02f; // luminance below which differences do not count relative
   float aaNormalCos = 0.9f;      // cos of the normal difference that flags (~25 degrees)
+  // With 24 or 48 sub-samples, shade a plain (untextured, not mirror or glass) surface once
+  // per cell of a 3 x 3 grid; its other sub-samples there measure coverage and take the
+  // nearest shaded one's radiance (adaptive.cpp).
+  bool aaDecoupled = true;
+  // ... unless that surface's shaded samples in the pixel differ in luminance by more than
+  // this share of the largest (a shadow's or highlight's edge): then all are shaded.
+  float aaShadingSpread = 0.25f;
   int threads = 0;    // 0 = all cores
   int maxDepth = 5;   // reflection/refraction recursion depth
   uint64_t seed = 1;
