@@ -39,6 +39,37 @@ size_t findInterval(const std::vector<double>& cdf, double x) {
   return i;
 }
 
+uint32_t reverseBits(uint32_t i) {
+  i = (i << 16u) | (i >> 16u);
+  i = ((i & 0x55555555u) << 1u) | ((i & 0xAAAAAAAAu) >> 1u);
+  i = ((i & 0x33333333u) << 2u) | ((i & 0xCCCCCCCCu) >> 2u);
+  i = ((i & 0x0F0F0F0Fu) << 4u) | ((i & 0xF0F0F0F0u) >> 4u);
+  return ((i & 0x00FF00FFu) << 8u) | ((i & 0xFF00FF00u) >> 8u);
+}
+
+// The second dimension of Sobol's sequence, as a 32-bit fraction. With the van der Corput
+// sequence (the first) it is a (0,2)-sequence in base 2: every aligned block of 2^m points
+// is a (0,m,2)-net, each of the 2^m dyadic boxes of area 2^-m, of any shape, holding one.
+uint32_t sobol2(uint32_t k) {
+  uint32_t r = 0;
+  for (uint32_t v = 1u << 31; k; k >>= 1, v ^= v >> 1)
+    if (k & 1) r ^= v;
+  return r;
+}
+
+// Owen's nested uniform scrambling of a 32-bit fraction, hash-based (Burley 2020, "Practical
+// hash-based Owen scrambling", after Laine and Karras 2011): each bit is flipped by a hash of
+// the bits above it and the seed. A scrambled net is still a net, but no longer a lattice.
+uint32_t owenScramble(uint32_t x, uint32_t seed) {
+  x = reverseBits(x);
+  x += seed;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return reverseBits(x);
+}
+
 // The integral of sqrt(1 - z^2) dz.
 double sinIntegral(double z) {
   return 0.5 * (z * std::sqrt(std::max(0.0, 1 - z * z)) + std::asin(std::clamp(z, -1.0, 1.0)));
@@ -100,7 +131,7 @@ void sampleEnvironment(const scene::Environment& env, int count, uint64_t seed, 
   if (progress) progress->add(double(count - n));
   if (!(rest > 0) || n == 0) return;
   Rng rng(seed, 0x656e766972ull);
-  const double shift1 = rng.uniformDouble(), shift2 = rng.uniformDouble();
+  const uint32_t scramble1 = rng.next(), scramble2 = rng.next();
   const double perLight = rest / (double(n) * kPi);  // every drawn light's luminance
   toLight.reserve(toLight.size() + size_t(n));
   intensity.reserve(intensity.size() + size_t(n));
@@ -108,10 +139,10 @@ void sampleEnvironment(const scene::Environment& env, int count, uint64_t seed, 
   std::unordered_map<size_t, size_t> merged;  // pixel -> index of its light
   std::vector<Vec3d> dirSum(toLight.size());
   for (int k = 0; k < n; ++k) {
-    // A Hammersley point, shifted modulo 1 (Cranley-Patterson).
-    double u1 = (double(k) + 0.5) / n + shift1, u2 = double(radicalInverse2(uint32_t(k))) + shift2;
-    u1 -= std::floor(u1);
-    u2 -= std::floor(u2);
+    // The Sobol' (0,2)-sequence, Owen-scrambled by the seed; the middle of the point's
+    // 2^-32 cell.
+    double u1 = (double(owenScramble(reverseBits(uint32_t(k)), scramble1)) + 0.5) * 0x1p-32;
+    double u2 = (double(owenScramble(sobol2(uint32_t(k)), scramble2)) + 0.5) * 0x1p-32;
     size_t j = findInterval(rowCdf, u1 * rest);
     double rowW = rowCdf[j + 1] - rowCdf[j];
     double f1 = std::clamp((u1 * rest - rowCdf[j]) / rowW, 0.0, 1.0);

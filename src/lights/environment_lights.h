@@ -1,9 +1,9 @@
 // Environment and sky light as directional lights (issue 24). Each environment_light or
 // sun_sky_light of the scene (scene/environment.h) becomes `lights` directional lights drawn
 // from its equirectangular table with density proportional to luminance x solid angle, on a
-// stratified point set (a Hammersley set, shifted by the seed, through the table's
-// marginal/conditional inversion: monotone in both coordinates, so the strata stay
-// strata). With S the sum over pixels of luminance Y x solid angle, a light drawn in pixel p
+// stratified point set (the first N points of Sobol's (0,2)-sequence, Owen-scrambled by the
+// seed, through the table's marginal/conditional inversion: monotone in both coordinates,
+// so the strata stay strata). With S the sum over pixels of luminance Y x solid angle, a light drawn in pixel p
 // of radiance L_p stands for the solid angle S / (N Y_p) and gets the intensity
 // L_p S / (N Y_p pi): every drawn light has the same luminance S / (N pi), one share. A
 // sun_sky_light's sun is one more light of intensity (its irradiance) / pi.
@@ -28,7 +28,7 @@ namespace lc::lights {
 
 struct EnvironmentLightOptions {
   std::optional<int> count;  // --env-lights: overrides every block's `lights`
-  uint64_t seed = 1;         // --seed: shifts the point set
+  uint64_t seed = 1;         // --seed: scrambles the point set
   uint64_t maxLights = 20'000'000;
   ProgressFn progress = {};  // the share of lights made (core/progress.h)
   const std::atomic<bool>* cancel = nullptr;  // stops and throws lc::Interrupted
