@@ -5,6 +5,7 @@ runs the scaling sweep, the 100k-light accuracy check and the ray/tree micro ben
 and writes the generated section of docs/BENCHMARKS.md and the images docs/images/bench_*.png.
 
   /usr/bin/python3 scripts/bench.py [--build DIR] [--quick] [--resume] [--only PART ...]
+      [--work DIR] [--no-docs] [--threads N]
 
 Environment: BUILD (build folder, default `build`), BENCH_QUICK=1 (same as --quick).
 
@@ -13,7 +14,8 @@ quick mode (small images, one run each, a few minutes) writes out/bench-quick/BE
 out/bench-quick/images/ and leaves docs/ alone unless --docs is given. Raw renders, --stats
 files, logs and results.json go to out/bench/ (or out/bench-quick/); --resume reuses the parts
 already in results.json (same commit) instead of measuring them again; --write-only
-regenerates the Markdown and images from results.json.
+regenerates the Markdown and images from results.json. A partial run (--only ROW ...) at full
+size without touching docs/: --only courtyard_sunsky garden_hdr --work out/bench-env --no-docs.
 
 Times: the render phase plus the light-tree build (`time_render_s + time_tree_s` of --stats),
 wall clock on all cores, median of repeated runs. Loading, Embree's BVH and VPL generation are
@@ -66,6 +68,11 @@ def main():
                     help="small sizes, one run each (also BENCH_QUICK=1)")
     ap.add_argument("--work", help="folder for renders and results.json (default out/bench or out/bench-quick)")
     ap.add_argument("--docs", action="store_true", help="in quick mode, write docs/ too")
+    ap.add_argument("--no-docs", action="store_true",
+                    help="in full mode, write the Markdown and images to the work folder, not docs/ (for a partial "
+                         "run with --only)")
+    ap.add_argument("--threads", type=int, default=0,
+                    help="--threads for every render (default: the binary's, all cores)")
     ap.add_argument("--resume", action="store_true", help="reuse parts already measured at this commit")
     ap.add_argument("--write-only", action="store_true", help="only rewrite the Markdown and images from results.json")
     ap.add_argument("--only", nargs="*", help="parts to run: row keys (" + ", ".join(r["key"] for r in ROWS) +

@@ -37,7 +37,7 @@ class Driver:
         self.build = a.build if os.path.isabs(a.build) else os.path.join(ROOT, a.build)
         self.lc = os.path.join(self.build, "lightcuts")
         self.work = os.path.join(ROOT, a.work or ("out/bench-quick" if self.quick else "out/bench"))
-        if a.docs or not self.quick:
+        if a.docs or (not self.quick and not getattr(a, "no_docs", False)):
             self.md = os.path.join(ROOT, "docs", "BENCHMARKS.md")
             self.images = os.path.join(ROOT, "docs", "images")
         else:
@@ -89,6 +89,8 @@ class Driver:
                "-q", "--stats", stats] + list(extra)
         if ref:
             cmd += ["--reference-pixels", str(ref)]
+        if getattr(self.a, "threads", 0):
+            cmd += ["--threads", str(self.a.threads)]
         if cut_heatmap:
             cmd += ["--cut-heatmap", base + "_cut.png"]
         self.run(cmd, commands)

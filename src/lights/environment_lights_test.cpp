@@ -130,6 +130,44 @@ TEST(EnvironmentLights, LightsInOneSmallPixelAreMerged) {
   EXPECT_NEAR(total, sunY + skyY, 1e-4 * (sunY + skyY));
 }
 
+// A whole pixel (under 4 pi / 4,096 sr) is treated alike at every N: the one-pixel sun is one
+// light of the pixel's exact power at its centroid at 1,024 lights and at 65,536 (where
+// the old bound, 4 pi / N sr, split it into thousands of lights, and the images stopped
+// converging: docs/BENCHMARKS.md, "Convergence").
+TEST(EnvironmentLights, WholePixelIsTreatedAlikeAtEveryCount) {
+  io::Image img(256, 128);
+  for (Color& c : img.pixels) c = Color(0.2f, 0.3f, 0.5f);
+  img.at(100, 40) = Color(50000, 45000, 40000);
+  std::string path = (std::filesystem::temp_directory_path() / "lc_env_test_sun_n.exr").string();
+  io::writeImage(path, img);
+  io::EnvironmentDesc d;
+  d.map = io::TextureRef{path, {}, true};
+  scene::Environment e = scene::Environment::build(d);
+  std::filesystem::remove(path);
+  double sunOmega = 2 * kPi / 256 * (std::cos(kPi * 40 / 128) - std::cos(kPi * 41 / 128));
+  ASSERT_GT(sunOmega, 4 * kPi / 65536);
+  Color sunL(50000, 45000, 40000);
+  Vec3 first;
+  for (int n : {1024, 4096, 65536}) {
+    std::vector<Vec3> dirs;
+    std::vector<Color> I;
+    sampleEnvironment(e, n, 1, dirs, I);
+    EXPECT_LE(dirs.size(), size_t(n));
+    int inSun = 0;
+    Color sunI(0);
+    Vec3 sunDir;
+    for (size_t k = 0; k < dirs.size(); ++k) {
+      double u, v;
+      e.coordinates(dirs[k], u, v);
+      if (int(u * 256) == 100 && int(v * 128) == 40) ++inSun, sunI = I[k], sunDir = dirs[k];
+    }
+    EXPECT_EQ(inSun, 1) << n << " lights";
+    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(sunI[ch] * kPi, sunL[ch] * sunOmega, 1e-5 * sunL[ch] * sunOmega) << n;
+    if (n == 1024) first = sunDir;
+    EXPECT_EQ(sunDir, first) << "the centroid, whatever N";
+  }
+}
+
 TEST(EnvironmentLights, DirectionsAndCoordinatesAreInverseWithUpAndRotate) {
   io::EnvironmentDesc d;
   d.up = Vec3(0.3f, 0.2f, -0.9f);
