@@ -50,7 +50,6 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
                                                   std::pair{"omni", lights::ObjectLightKind::Omni}});
   const char* placement = nameOf(o.objectLights.placement, {std::pair{"stratified", lights::Placement::Stratified},
                                                             std::pair{"seed", lights::Placement::Course}});
-  const char* normalize = io::vplNormalizeName(vpl.normalize);
   const std::string lightsGroup = "Lights & GI";
   const std::string limitsGroup = "Limits";
 
@@ -104,14 +103,9 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
                              fmt::format("Instant radiosity: diffuse bounces; default the scene's, else {}", vpl.bounces))
       ->check(CLI::Range(0, 64))
       ->group(lightsGroup);
-  // The names, checked here once, and the values: io::VplNormalize (io/scene_desc.h).
-  std::vector<std::string> normalizeNames;
-  for (const auto& [value, name] : io::kVplNormalizeNames) normalizeNames.emplace_back(name);
-  c.add_option_function<std::string>("--vpl-normalize",
-                                     [&o](const std::string& v) { o.vplNormalize = io::parseVplNormalize(v); },
-                                     fmt::format("VPL intensities: power (energy conserving) or object (the seed's "
-                                                 "per-object division); default the scene's, else {}", normalize))
-      ->check(CLI::IsMember(normalizeNames))
+  addEnumOption(c, "--vpl-normalize", io::kVplNormalizeNames, [&o](io::VplNormalize v) { o.vplNormalize = v; },
+                fmt::format("VPL intensities: {}; default the scene's, else {}", enumHelp(io::kVplNormalizeNames),
+                            io::vplNormalizeName(vpl.normalize)))
       ->group(lightsGroup);
   c.add_option_function<float>("--vpl-clamp", [&o](const float& v) { o.vplClamp = v; },
                                fmt::format("VPL distance clamp, as a fraction of half the scene diagonal; default the "
@@ -129,12 +123,9 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
                              "scene's instant_radiosity caustics, else 0 (off)")
       ->check(CLI::Range(0, 1 << 30))
       ->group(lightsGroup);
-  c.add_option_function<std::string>("--caustic-lights", [&o](const std::string& v) { o.causticLights = v; },
-                                     fmt::format("Caustic lights: vpl (an oriented light lifted off the hit, facing "
-                                                 "it) or spot (the seed's: a spot at the last mirror or glass vertex); "
-                                                 "default the scene's, else {}",
-                                                 lights::causticLightKindName(lights::CausticOptions{}.kind)))
-      ->check(CLI::IsMember({"vpl", "spot"}))
+  addEnumOption(c, "--caustic-lights", io::kCausticLightKindNames, [&o](io::CausticLightKind k) { o.causticLights = k; },
+                fmt::format("Caustic lights: {}; default the scene's, else {}", enumHelp(io::kCausticLightKindNames),
+                            io::causticLightKindName(lights::CausticOptions{}.kind)))
       ->group(lightsGroup);
   c.add_option_function<float>("--caustic-smoothing", [&o](const float& v) { o.causticSmoothing = v; },
                                fmt::format("Caustic lights' footprint, times the distance to the {}th nearest other "

@@ -219,7 +219,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["caustic_lights"] = ls.caustics.lights;
   j["caustics"] = {{"paths", ls.caustics.paths},
                    {"lights", ls.caustics.lights},
-                   {"kind", lights::causticLightKindName(ls.caustics.kind)},
+                   {"kind", io::causticLightKindName(ls.caustics.kind)},
                    {"time_s", ls.caustics.seconds},
                    {"mean_radius", ls.caustics.meanRadius},
                    {"power", {ls.caustics.power.x, ls.caustics.power.y, ls.caustics.power.z}}};
@@ -262,7 +262,7 @@ void printRenderSummary(const RenderReport& r) {
                ls.vpls.paths, formatSeconds(ls.vpls.seconds), ls.vpls.clampDistance, 100 * r.clampedFraction);
   if (ls.caustics.paths)
     fmt::print("caustics   {} {} lights from {} paths in {} (footprint {:.4g}); shadow rays stop at glass\n",
-               ls.caustics.lights, lights::causticLightKindName(ls.caustics.kind), ls.caustics.paths,
+               ls.caustics.lights, io::causticLightKindName(ls.caustics.kind), ls.caustics.paths,
                formatSeconds(ls.caustics.seconds), ls.caustics.meanRadius);
   if (method == lightcuts::Method::Brute)
     fmt::print("method     brute force\n");
