@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <initializer_list>
 #include <sstream>
 
 #include "core/memory_budget.h"
@@ -24,14 +23,6 @@ const CLI::Validator kLimitValue(
     },
     "INT>=0");
 
-// The name of `value` among `names` (the spelling the option takes), for the help's defaults.
-template <typename E>
-const char* nameOf(E value, std::initializer_list<std::pair<const char*, E>> names) {
-  for (const auto& [n, v] : names)
-    if (v == value) return n;
-  return "?";
-}
-
 }  // namespace
 
 const char* switchName(bool on) { return on ? "on" : "off"; }
@@ -46,10 +37,6 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
   // what o leaves unset (the scene's instant_radiosity block comes between).
   const lights::VplOptions vpl;
   const io::LightDesc light;
-  const char* kind = nameOf(o.objectLights.kind, {std::pair{"oriented", lights::ObjectLightKind::Oriented},
-                                                  std::pair{"omni", lights::ObjectLightKind::Omni}});
-  const char* placement = nameOf(o.objectLights.placement, {std::pair{"stratified", lights::Placement::Stratified},
-                                                            std::pair{"seed", lights::Placement::Course}});
   const std::string lightsGroup = "Lights & GI";
   const std::string limitsGroup = "Limits";
 
@@ -57,19 +44,17 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
              fmt::format("Skip unknown keywords in .ray files with a warning instead of failing (default {})",
                          o.lenient ? "on" : "off"))
       ->group("Scene");
-  c.add_option("--object-lights", [&o](const CLI::results_t& r) {
-     o.objectLights.kind = lights::parseObjectLightKind(r[0]);
-     return true;
-   }, fmt::format("Lights of luminous objects: oriented (cosine emission about the surface normal) or omni (the "
-                  "seed's); default {}", kind))
-      ->check(CLI::IsMember({"oriented", "omni"}))
+  // Options with named values: their names, checked here once, and the help's list come
+  // from their enums' tables (lights/object_lights.h, io/scene_desc.h).
+  addEnumOption(c, "--object-lights", lights::kObjectLightKindNames,
+                [&o](lights::ObjectLightKind k) { o.objectLights.kind = k; },
+                fmt::format("Lights of luminous objects: {}; default {}", enumHelp(lights::kObjectLightKindNames),
+                            lights::objectLightKindName(o.objectLights.kind)))
       ->group(lightsGroup);
-  c.add_option("--object-light-placement", [&o](const CLI::results_t& r) {
-     o.objectLights.placement = lights::parsePlacement(r[0]);
-     return true;
-   }, fmt::format("Where object lights go: stratified (area-uniform low-discrepancy) or seed (the seed's pattern); "
-                  "default {}", placement))
-      ->check(CLI::IsMember({"stratified", "seed", "course"}))
+  addEnumOption(c, "--object-light-placement", lights::kPlacementNames,
+                [&o](lights::Placement p) { o.objectLights.placement = p; },
+                fmt::format("Where object lights go: {}; default {}", enumHelp(lights::kPlacementNames),
+                            lights::placementName(o.objectLights.placement)))
       ->group(lightsGroup);
   c.add_option_function<float>("--emission-density", [&o](const float& v) { o.emissionDensity = v; },
                                fmt::format("Point lights per unit of world area for `emission = (r,g,b)` object "
