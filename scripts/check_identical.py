@@ -11,11 +11,12 @@ reconstruction cuts, whose tiles are 64 pixels) and with --threads (default 2), 
 binaries run from twin folders as `./lightcuts` with the same arguments, so the files' text
 metadata (the command line) agrees and the EXR files must be equal byte for byte. Beside the
 default render, variants exercise what the default at this size leaves out: reconstruction
-cuts and reference pixels, the other methods, --vpl-normalize object. The --stats values
-that depend only on the image and the pixels (the reference pixels' errors, the counters of
-a render without reconstruction cuts: those with them count samples that two tiles may both
-make, depending on timing) must be equal too. Exit status 0 when everything matches, 1
-otherwise; each difference is named, with `lightcuts compare`'s numbers for the image."""
+cuts and reference pixels, the other methods, --vpl-normalize object, the other values of the
+options with named values. The --stats values that depend only on the image and the pixels
+(the reference pixels' errors, the counters of a render without reconstruction cuts: those
+with them count samples that two tiles may both make, depending on timing) must be equal
+too. Exit status 0 when everything matches, 1 otherwise; each difference is named, with
+`lightcuts compare`'s numbers for the image."""
 
 import argparse
 import filecmp
@@ -48,6 +49,11 @@ EXTRA = [
     ("scenes/cornell_box.ray", "probes-off-walter",
      ["--visibility-probes", "off", "--cut-criterion", "walter", "--gi", "off", "--aa", "off"], None),
     ("scenes/green_light_emitter.ray", "error-floor0", ["--error-floor", "0", "--error", "0.05"], None),
+    # The named values other than the defaults, aliases among them.
+    ("scenes/cornell_box.ray", "course-tree-omni",
+     ["--tree", "course", "--estimator", "representative", "--object-lights", "omni",
+      "--object-light-placement", "course"], None),
+    ("scenes/mirror_ring.ray", "caustic-spot", ["--caustic-lights", "spot", "--caustics", "20000"], None),
 ]
 QUICK = ["scenes/cornell_box.ray", "scenes/green_light_emitter.ray", "scenes/mirror_ring.ray",
          "scenes/ball_lens.ray", "scenes/features/spotlights.ray"]

@@ -177,7 +177,6 @@ struct RenderSetup {
   lightcuts::Method method = lightcuts::Method::Lightcuts;
   lightcuts::TreeBuildOptions tb;
   float error = 0;  // --error, resolved by method
-  io::ToneMap tonemap = io::ToneMap::Srgb;
   LoadedScene ls;
   lightcuts::LightForest forest;
   std::unique_ptr<lightcuts::LightEvaluator> evaluator;
@@ -205,15 +204,14 @@ void checkArgs(RenderArgs& a, RenderSetup& s) {
     if (!a.stats.empty()) checkWritable(a.stats);
     if (!a.cutHeatmap.empty()) checkWritable(a.cutHeatmap);
   }
-  s.method = lightcuts::parseMethod(a.method);
-  s.tb.builder = a.tree.empty() ? (s.method == lightcuts::Method::Course ? lightcuts::TreeBuilder::Course
-                                                                        : lightcuts::TreeBuilder::Agglomerative)
-                                : lightcuts::parseTreeBuilder(a.tree);
+  s.method = a.method;
+  s.tb.builder = a.tree ? *a.tree
+                        : s.method == lightcuts::Method::Course ? lightcuts::TreeBuilder::Course
+                                                                : lightcuts::TreeBuilder::Agglomerative;
   s.tb.seed = a.seed;
   s.error = a.error >= 0 ? a.error
                          : (s.method == lightcuts::Method::Course ? kCourseDefaultError : kLightcutsDefaultError);
   if (!std::isfinite(s.error)) throw Error("--error must be a finite number >= 0");
-  s.tonemap = io::parseToneMap(a.tonemap);
   if (!std::isfinite(a.exposure)) throw Error("--exposure must be a finite number");
 }
 
@@ -244,8 +242,7 @@ void resolveImageSize(RenderArgs& a, const io::CameraDesc& cam) {
 void buildEvaluator(const RenderArgs& a, RenderSetup& s) {
   const scene::Scene& scene = *s.ls.scene;
   s.tb.sceneDiagonal = scene.bounds().diagonal();
-  lightcuts::CutOptions co{s.error, a.maxCut, lightcuts::parseCutCriterion(a.criterion),
-                           lightcuts::parseEstimator(a.estimator), a.visibilityProbes};
+  lightcuts::CutOptions co{s.error, a.maxCut, a.criterion, a.estimator, a.visibilityProbes};
   co.stochasticCut = a.stochasticCut;
   co.seed = a.seed;
   if (s.method == lightcuts::Method::Brute) {
@@ -269,7 +266,7 @@ render::RenderOptions renderOptions(const RenderArgs& a, lightcuts::Method metho
   ro.width = a.width;
   ro.height = a.height;
   ro.spp = a.spp;
-  ro.aa = render::parseAntiAliasing(a.aa);
+  ro.aa = a.aa;
   ro.aaSamples = a.aaSamples;
   ro.threads = a.threads;
   ro.maxDepth = a.maxDepth;
@@ -296,7 +293,7 @@ bool setUpRender(RenderArgs& a, Cluster* cluster, RenderSetup& s) {
   // sRGB texture maps (from MTL files) are linearised whenever the output is display-encoded
   // (srgb, filmic; the EXR of such a render too, so that both formats hold one linear image);
   // --tonemap clamp keeps the course renderer's look: textures and output as stored.
-  a.load.linearizeSrgbTextures = s.tonemap != io::ToneMap::Clamp;
+  a.load.linearizeSrgbTextures = a.tonemap != io::ToneMap::Clamp;
   a.load.quiet = a.quiet;
   a.load.interruptible = true;
   try {
@@ -423,12 +420,12 @@ void reportRender(const RenderArgs& a, Cluster* cluster, const RenderSetup& s, c
   const scene::Scene& scene = *s.ls.scene;
   const render::RenderResult& rr = run.rr;
   io::WriteOptions wo;
-  wo.tonemap = s.tonemap;
+  wo.tonemap = a.tonemap;
   wo.exposure = a.exposure;
   wo.metadata = metadata(a);
   wo.channels = aovChannels(s.aovs, scene, s.ro, rr);
   if (s.ext != "exr") {
-    wo.metadata.emplace_back("Tone map", a.tonemap);
+    wo.metadata.emplace_back("Tone map", io::toneMapName(a.tonemap));
     wo.metadata.emplace_back("Exposure", fmt::format("{:g}", a.exposure));
   }
   io::writeImage(a.out, rr.image, wo);
@@ -436,7 +433,7 @@ void reportRender(const RenderArgs& a, Cluster* cluster, const RenderSetup& s, c
     // Judged as displayed: the 8-bit output's tone map, or sRGB for an EXR viewed as usual.
     const auto& es = rr.stats.eval;
     RenderFacts facts{scene.lights().size(), rr.stats.primaryRays, es.shadingPoints, es.shadowRays, es.occludedRays};
-    std::string w = blackImageWarning(rr.image, s.ext == "exr" ? io::ToneMap::Srgb : s.tonemap, a.exposure, facts);
+    std::string w = blackImageWarning(rr.image, s.ext == "exr" ? io::ToneMap::Srgb : a.tonemap, a.exposure, facts);
     if (!w.empty()) printWarning(w);
   }
   if (!a.cutHeatmap.empty()) {
@@ -495,13 +492,11 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--cut-heatmap", a->cutHeatmap,
                 "Write the per-pixel cut size, colour-mapped with a legend, to this PNG; default none")
       ->group(output);
-  c->add_option("--tonemap", a->tonemap,
-                fmt::format("8-bit output (.png .ppm .bmp): srgb (the linear image sRGB-encoded for display), filmic "
-                            "(highlights roll off: Narkowicz's ACES fit, then sRGB) or clamp (values stored as they "
-                            "are, the course renderer's look; sRGB textures not linearised); .exr stays linear; "
-                            "default {}",
-                            d.tonemap))
-      ->check(CLI::IsMember({"clamp", "srgb", "filmic"}))
+  // Options with named values take their names, their check and the help's list from their
+  // enums' tables (addEnumOption, app/scene_options.h).
+  addEnumOption(*c, "--tonemap", io::kToneMapNames, [a](io::ToneMap t) { a->tonemap = t; },
+                fmt::format("8-bit output (.png .ppm .bmp): {}; .exr stays linear; default {}",
+                            enumHelp(io::kToneMapNames), io::toneMapName(d.tonemap)))
       ->group(output);
   c->add_option("--exposure", a->exposure,
                 fmt::format("Exposure in stops for 8-bit output: linear values are scaled by 2^EV before the tone "
@@ -525,14 +520,9 @@ void addRenderCommand(CLI::App& app) {
       ->check(CLI::Range(1, 65536))
       ->group(image);
   {
-    const render::RenderOptions ro;
-    c->add_option("--aa", a->aa,
-                  fmt::format("Antialiasing with --spp 1: adaptive (a pixel whose centre ray differs from a "
-                              "neighbour's in shape, in normal by more than {:.0f} degrees, or in luminance by more "
-                              "than {:g}% is re-sampled with --aa-samples stratified sub-samples) or off (the pixel "
-                              "centre only); default {}",
-                              std::acos(ro.aaNormalCos) * 180 / kPi, 100 * ro.aaContrast, d.aa))
-        ->check(CLI::IsMember({"adaptive", "off"}))
+    addEnumOption(*c, "--aa", render::kAntiAliasingNames, [a](render::AntiAliasing aa) { a->aa = aa; },
+                  fmt::format("Antialiasing with --spp 1: {}; default {}", render::antiAliasingHelp(),
+                              render::antiAliasingName(d.aa)))
         ->group(image);
     c->add_option("--aa-samples", a->aaSamples,
                   fmt::format("Adaptive antialiasing: sub-samples at a re-sampled pixel, with its centre a g x g "
@@ -565,22 +555,20 @@ void addRenderCommand(CLI::App& app) {
                                    fmt::format("Random seed (sampling, representatives, VPL paths, object-light placement; overrides "
                                                "instant_radiosity's seed); default {}", d.seed))
       ->group(image);
-  c->add_option("--method", a->method,
-                fmt::format("Direct lighting: lightcuts (Walter et al. 2005), seed (the course project's cuts), "
-                            "stochastic (stochastic lightcuts, Yuksel 2019: unbiased, noisy, no error bound; average "
-                            "with --spp) or brute; default {}", d.method))
-      ->check(CLI::IsMember({"lightcuts", "seed", "course", "stochastic", "brute"}))
+  addEnumOption(*c, "--method", lightcuts::kMethodNames, [a](lightcuts::Method m) { a->method = m; },
+                fmt::format("Direct lighting: {}; default {}", enumHelp(lightcuts::kMethodNames),
+                            lightcuts::methodName(d.method)))
       ->group(cuts);
   c->add_option("--stochastic-cut", a->stochasticCut,
                 fmt::format("--method stochastic: clusters per shading point, one light drawn in each; default {}",
                             lightcuts::CutOptions{}.stochasticCut))
       ->check(CLI::Range(1, 1 << 20))
       ->group(cuts);
-  c->add_option("--tree", a->tree,
-                fmt::format("Light tree: walter (agglomerative) or seed (k-d split); default {} for --method seed, "
-                            "else {}", lightcuts::treeBuilderName(lightcuts::TreeBuilder::Course),
+  addEnumOption(*c, "--tree", lightcuts::kTreeBuilderNames, [a](lightcuts::TreeBuilder b) { a->tree = b; },
+                fmt::format("Light tree: {}; default {} for --method {}, else {}", enumHelp(lightcuts::kTreeBuilderNames),
+                            lightcuts::treeBuilderName(lightcuts::TreeBuilder::Course),
+                            lightcuts::methodName(lightcuts::Method::Course),
                             lightcuts::treeBuilderName(lightcuts::TreeBuilder::Agglomerative)))
-      ->check(CLI::IsMember({"walter", "agglomerative", "seed", "course"}))
       ->group(cuts);
   c->add_option("--error", a->error,
                 fmt::format("Error threshold: relative bound for lightcuts (default {}); radius/distance for seed "
@@ -598,17 +586,14 @@ void addRenderCommand(CLI::App& app) {
                             d.errorFloor))
       ->check(CLI::IsMember({"auto"}) | CLI::Range(0.0, 1e30))
       ->group(cuts);
-  c->add_option("--cut-criterion", a->criterion,
-                fmt::format("When a lightcut stops: total (every bound below error x estimate and the root-sum-square "
-                            "of the error spreads below 1.6 x that) or walter (every bound below error x estimate, as "
-                            "published); default {}", d.criterion))
-      ->check(CLI::IsMember({"total", "walter"}))
+  addEnumOption(*c, "--cut-criterion", lightcuts::kCutCriterionNames,
+                [a](lightcuts::CutCriterion k) { a->criterion = k; },
+                fmt::format("When a lightcut stops: {}; default {}", enumHelp(lightcuts::kCutCriterionNames),
+                            lightcuts::cutCriterionName(d.criterion)))
       ->group(cuts);
-  c->add_option("--estimator", a->estimator,
-                fmt::format("A cluster's estimate (lightcuts): first-order (its representative's, less the first-order "
-                            "change from the cluster's mean light, where smooth) or representative (as published); "
-                            "default {}", d.estimator))
-      ->check(CLI::IsMember({"first-order", "representative"}))
+  addEnumOption(*c, "--estimator", lightcuts::kEstimatorNames, [a](lightcuts::Estimator e) { a->estimator = e; },
+                fmt::format("A cluster's estimate (lightcuts): {}; default {}", enumHelp(lightcuts::kEstimatorNames),
+                            lightcuts::estimatorName(d.estimator)))
       ->group(cuts);
   addSwitch(*c, "--visibility-probes", a->visibilityProbes,
             fmt::format("Lightcuts: before refining a cluster whose representative is hidden, test the corners of "

@@ -97,11 +97,11 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
     const auto& ir = desc.instantRadiosity;
     if (ir) {
       if (ir->caustics) c.paths = *ir->caustics;
-      if (ir->causticLights) c.kind = lights::parseCausticLightKind(*ir->causticLights);
+      if (ir->causticLights) c.kind = *ir->causticLights;
       if (ir->seed) c.seed = *ir->seed;
     }
     if (o.causticPaths) c.paths = *o.causticPaths;
-    if (o.causticLights) c.kind = lights::parseCausticLightKind(*o.causticLights);
+    if (o.causticLights) c.kind = *o.causticLights;
     if (o.causticSmoothing) c.smoothing = *o.causticSmoothing;
     if (o.vplSeed) c.seed = *o.vplSeed;
     c.maxLights = o.limits.maxLights;

@@ -40,7 +40,7 @@ struct LoadOptions {
   // Caustics (lights/caustics.h): --caustics and --caustic-lights over instant_radiosity's
   // caustics and caustic_lights.
   std::optional<int> causticPaths;
-  std::optional<std::string> causticLights;
+  std::optional<io::CausticLightKind> causticLights;
   std::optional<float> causticSmoothing;
   // Linearise sRGB-marked (MTL) textures: scene::BuildOptions::linearizeSrgbTextures.
   bool linearizeSrgbTextures = false;

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include <cmath>
-#include <initializer_list>
 #include <sstream>
 
 #include "core/memory_budget.h"
@@ -24,14 +23,6 @@ const CLI::Validator kLimitValue(
     },
     "INT>=0");
 
-// The name of `value` among `names` (the spelling the option takes), for the help's defaults.
-template <typename E>
-const char* nameOf(E value, std::initializer_list<std::pair<const char*, E>> names) {
-  for (const auto& [n, v] : names)
-    if (v == value) return n;
-  return "?";
-}
-
 }  // namespace
 
 const char* switchName(bool on) { return on ? "on" : "off"; }
@@ -46,11 +37,6 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
   // what o leaves unset (the scene's instant_radiosity block comes between).
   const lights::VplOptions vpl;
   const io::LightDesc light;
-  const char* kind = nameOf(o.objectLights.kind, {std::pair{"oriented", lights::ObjectLightKind::Oriented},
-                                                  std::pair{"omni", lights::ObjectLightKind::Omni}});
-  const char* placement = nameOf(o.objectLights.placement, {std::pair{"stratified", lights::Placement::Stratified},
-                                                            std::pair{"seed", lights::Placement::Course}});
-  const char* normalize = io::vplNormalizeName(vpl.normalize);
   const std::string lightsGroup = "Lights & GI";
   const std::string limitsGroup = "Limits";
 
@@ -58,19 +44,17 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
              fmt::format("Skip unknown keywords in .ray files with a warning instead of failing (default {})",
                          o.lenient ? "on" : "off"))
       ->group("Scene");
-  c.add_option("--object-lights", [&o](const CLI::results_t& r) {
-     o.objectLights.kind = lights::parseObjectLightKind(r[0]);
-     return true;
-   }, fmt::format("Lights of luminous objects: oriented (cosine emission about the surface normal) or omni (the "
-                  "seed's); default {}", kind))
-      ->check(CLI::IsMember({"oriented", "omni"}))
+  // Options with named values: their names, checked here once, and the help's list come
+  // from their enums' tables (lights/object_lights.h, io/scene_desc.h).
+  addEnumOption(c, "--object-lights", lights::kObjectLightKindNames,
+                [&o](lights::ObjectLightKind k) { o.objectLights.kind = k; },
+                fmt::format("Lights of luminous objects: {}; default {}", enumHelp(lights::kObjectLightKindNames),
+                            lights::objectLightKindName(o.objectLights.kind)))
       ->group(lightsGroup);
-  c.add_option("--object-light-placement", [&o](const CLI::results_t& r) {
-     o.objectLights.placement = lights::parsePlacement(r[0]);
-     return true;
-   }, fmt::format("Where object lights go: stratified (area-uniform low-discrepancy) or seed (the seed's pattern); "
-                  "default {}", placement))
-      ->check(CLI::IsMember({"stratified", "seed", "course"}))
+  addEnumOption(c, "--object-light-placement", lights::kPlacementNames,
+                [&o](lights::Placement p) { o.objectLights.placement = p; },
+                fmt::format("Where object lights go: {}; default {}", enumHelp(lights::kPlacementNames),
+                            lights::placementName(o.objectLights.placement)))
       ->group(lightsGroup);
   c.add_option_function<float>("--emission-density", [&o](const float& v) { o.emissionDensity = v; },
                                fmt::format("Point lights per unit of world area for `emission = (r,g,b)` object "
@@ -104,14 +88,9 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
                              fmt::format("Instant radiosity: diffuse bounces; default the scene's, else {}", vpl.bounces))
       ->check(CLI::Range(0, 64))
       ->group(lightsGroup);
-  // The names, checked here once, and the values: io::VplNormalize (io/scene_desc.h).
-  std::vector<std::string> normalizeNames;
-  for (const auto& [value, name] : io::kVplNormalizeNames) normalizeNames.emplace_back(name);
-  c.add_option_function<std::string>("--vpl-normalize",
-                                     [&o](const std::string& v) { o.vplNormalize = io::parseVplNormalize(v); },
-                                     fmt::format("VPL intensities: power (energy conserving) or object (the seed's "
-                                                 "per-object division); default the scene's, else {}", normalize))
-      ->check(CLI::IsMember(normalizeNames))
+  addEnumOption(c, "--vpl-normalize", io::kVplNormalizeNames, [&o](io::VplNormalize v) { o.vplNormalize = v; },
+                fmt::format("VPL intensities: {}; default the scene's, else {}", enumHelp(io::kVplNormalizeNames),
+                            io::vplNormalizeName(vpl.normalize)))
       ->group(lightsGroup);
   c.add_option_function<float>("--vpl-clamp", [&o](const float& v) { o.vplClamp = v; },
                                fmt::format("VPL distance clamp, as a fraction of half the scene diagonal; default the "
@@ -129,12 +108,9 @@ void addSceneOptions(CLI::App& c, LoadOptions& o) {
                              "scene's instant_radiosity caustics, else 0 (off)")
       ->check(CLI::Range(0, 1 << 30))
       ->group(lightsGroup);
-  c.add_option_function<std::string>("--caustic-lights", [&o](const std::string& v) { o.causticLights = v; },
-                                     fmt::format("Caustic lights: vpl (an oriented light lifted off the hit, facing "
-                                                 "it) or spot (the seed's: a spot at the last mirror or glass vertex); "
-                                                 "default the scene's, else {}",
-                                                 lights::causticLightKindName(lights::CausticOptions{}.kind)))
-      ->check(CLI::IsMember({"vpl", "spot"}))
+  addEnumOption(c, "--caustic-lights", io::kCausticLightKindNames, [&o](io::CausticLightKind k) { o.causticLights = k; },
+                fmt::format("Caustic lights: {}; default the scene's, else {}", enumHelp(io::kCausticLightKindNames),
+                            io::causticLightKindName(lights::CausticOptions{}.kind)))
       ->group(lightsGroup);
   c.add_option_function<float>("--caustic-smoothing", [&o](const float& v) { o.causticSmoothing = v; },
                                fmt::format("Caustic lights' footprint, times the distance to the {}th nearest other "

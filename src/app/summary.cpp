@@ -150,7 +150,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["width"] = a.width;
   j["height"] = a.height;
   j["spp"] = a.spp;
-  j["aa"] = a.spp == 1 ? a.aa : "off";
+  j["aa"] = render::antiAliasingName(a.spp == 1 ? a.aa : render::AntiAliasing::Off);
   j["aa_samples"] = a.aaSamples;
   j["aa_pixels"] = rr.stats.aaPixels;
   j["aa_sub_samples"] = rr.stats.aaSubSamples;
@@ -160,8 +160,8 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["max_cut"] = a.maxCut;
   j["error_floor"] = rr.stats.errorFloor;
   j["error_floor_pixels"] = rr.stats.errorFloorPixels;
-  j["cut_criterion"] = a.criterion;
-  j["estimator"] = a.estimator;
+  j["cut_criterion"] = lightcuts::cutCriterionName(a.criterion);
+  j["estimator"] = lightcuts::estimatorName(a.estimator);
   j["visibility_probes"] = switchName(a.visibilityProbes);
   j["probed_clusters"] = es.probedClusters;
   j["probe_rays"] = es.probeRays;
@@ -176,7 +176,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["reconstruction_fallbacks"] = rr.stats.reconstructionFallbacks;
   j["reconstruction_coarse_cells"] = rr.stats.reconstructionCoarseCells;
   j["max_depth"] = a.maxDepth;
-  j["tonemap"] = a.tonemap;
+  j["tonemap"] = io::toneMapName(a.tonemap);
   j["exposure"] = a.exposure;
   j["time_total_s"] = total;
   j["time_load_s"] = ls.loadSeconds;
@@ -219,7 +219,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["caustic_lights"] = ls.caustics.lights;
   j["caustics"] = {{"paths", ls.caustics.paths},
                    {"lights", ls.caustics.lights},
-                   {"kind", lights::causticLightKindName(ls.caustics.kind)},
+                   {"kind", io::causticLightKindName(ls.caustics.kind)},
                    {"time_s", ls.caustics.seconds},
                    {"mean_radius", ls.caustics.meanRadius},
                    {"power", {ls.caustics.power.x, ls.caustics.power.y, ls.caustics.power.z}}};
@@ -262,7 +262,7 @@ void printRenderSummary(const RenderReport& r) {
                ls.vpls.paths, formatSeconds(ls.vpls.seconds), ls.vpls.clampDistance, 100 * r.clampedFraction);
   if (ls.caustics.paths)
     fmt::print("caustics   {} {} lights from {} paths in {} (footprint {:.4g}); shadow rays stop at glass\n",
-               ls.caustics.lights, lights::causticLightKindName(ls.caustics.kind), ls.caustics.paths,
+               ls.caustics.lights, io::causticLightKindName(ls.caustics.kind), ls.caustics.paths,
                formatSeconds(ls.caustics.seconds), ls.caustics.meanRadius);
   if (method == lightcuts::Method::Brute)
     fmt::print("method     brute force\n");
@@ -270,7 +270,10 @@ void printRenderSummary(const RenderReport& r) {
     fmt::print("method     {} (tree {}: {} nodes, {:.1f} MiB, built in {}), error {}{}, max cut {}\n",
                lightcuts::methodName(method), lightcuts::treeBuilderName(r.treeBuilder), forest.nodeCount(),
                double(forest.memoryBytes()) / (1 << 20), formatSeconds(forest.buildSeconds), error,
-               method == lightcuts::Method::Lightcuts ? " (" + a.criterion + " criterion)" : "", a.maxCut);
+               method == lightcuts::Method::Lightcuts
+                   ? fmt::format(" ({} criterion)", lightcuts::cutCriterionName(a.criterion))
+                   : std::string(),
+               a.maxCut);
   fmt::print("image      {}x{}, {} spp{} -> {}\n", a.width, a.height, a.spp,
              ro.spp == 1 && ro.aa == render::AntiAliasing::Adaptive
                  ? fmt::format(", adaptive antialiasing: {} pixels ({:.1f}%) re-sampled {} times",

@@ -680,22 +680,6 @@ uint8_t quantize8(float v, ToneMap tonemap, float scale) {
   return uint8_t(std::lround(v * 255.0f));
 }
 
-ToneMap parseToneMap(const std::string& name) {
-  if (name == "clamp") return ToneMap::Clamp;
-  if (name == "srgb") return ToneMap::Srgb;
-  if (name == "filmic") return ToneMap::Filmic;
-  throw Error("unknown tone map " + quoteInput(name) + " (use clamp, srgb or filmic)");
-}
-
-const char* toneMapName(ToneMap tonemap) {
-  switch (tonemap) {
-    case ToneMap::Clamp: return "clamp";
-    case ToneMap::Srgb: return "srgb";
-    case ToneMap::Filmic: return "filmic";
-  }
-  return "clamp";
-}
-
 bool isWritableImageExtension(const std::string& ext) {
   std::string e = normalizeExt(ext);
   return e == "png" || e == "ppm" || e == "bmp" || e == "exr";

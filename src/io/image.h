@@ -6,9 +6,11 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "core/error.h"
 #include "core/limits.h"
 #include "core/math.h"
@@ -31,6 +33,12 @@ struct Image {
 //   Filmic: Narkowicz's fit of the ACES filmic curve applied to 0.6 v (highlights roll off
 //           instead of clipping), then the sRGB OETF.
 enum class ToneMap { Clamp, Srgb, Filmic };
+// Its names (core/enum_names.h), in the order render --tonemap's help lists them.
+inline constexpr EnumName<ToneMap> kToneMapNames[] = {
+    {ToneMap::Srgb, "srgb", "the linear image sRGB-encoded for display"},
+    {ToneMap::Filmic, "filmic", "highlights roll off: Narkowicz's ACES fit, then sRGB"},
+    {ToneMap::Clamp, "clamp",
+     "values stored as they are, the course renderer's look; sRGB textures not linearised"}};
 
 using TextMetadata = std::vector<std::pair<std::string, std::string>>;  // (key, value)
 
@@ -101,9 +109,9 @@ float linearToSrgb(float v);
 // The 8-bit value writeImage stores for a linear channel value (scale = 2^exposure).
 uint8_t quantize8(float v, ToneMap tonemap, float scale = 1);
 
-// ToneMap by name ("clamp", "srgb", "filmic") and back; parse throws lc::Error on others.
-ToneMap parseToneMap(const std::string& name);
-const char* toneMapName(ToneMap tonemap);
+// ToneMap by name (kToneMapNames) and back; parse throws lc::Error on others.
+inline ToneMap parseToneMap(std::string_view name) { return parseEnum(kToneMapNames, name, "tone map"); }
+inline const char* toneMapName(ToneMap tonemap) { return enumName(kToneMapNames, tonemap); }
 
 // True for extensions writeImage accepts.
 bool isWritableImageExtension(const std::string& ext);

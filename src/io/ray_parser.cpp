@@ -933,6 +933,8 @@ void Parser::areaLight(const Token& kw) {
 //                     normalize = "power" | "object"; clamp = c >= 0; seed = 64-bit integer;
 //                     caustics = n >= 0; caustic_lights = "vpl" | "spot"; }
 // Every field is optional; command-line flags override. A second block updates the first.
+// The names of normalize and caustic_lights are their enums' (kVplNormalizeNames,
+// kCausticLightKindNames in scene_desc.h).
 void Parser::instantRadiosity(const Token& kw) {
   InstantRadiosityDesc ir = scene_.instantRadiosity.value_or(InstantRadiosityDesc{});
   ir.loc = lex_.loc(kw);
@@ -947,8 +949,8 @@ void Parser::instantRadiosity(const Token& kw) {
       ir.bounces = int(integerValue("bounces", 1000));
     } else if (w == "normalize") {
       Token t = lex_.next();
-      std::optional<VplNormalize> v = t.kind == TokenKind::Ident ? findVplNormalize(t.text) : std::nullopt;
-      if (!v) expected(vplNormalizeChoices("\"") + " for normalize", t);
+      std::optional<VplNormalize> v = t.kind == TokenKind::Ident ? findEnum(kVplNormalizeNames, t.text) : std::nullopt;
+      if (!v) expected(enumChoices(kVplNormalizeNames, "\"") + " for normalize", t);
       ir.normalize = *v;
     } else if (w == "clamp") {
       ir.clamp = nonNegative("clamp");
@@ -958,9 +960,10 @@ void Parser::instantRadiosity(const Token& kw) {
       ir.caustics = int(integerValue("caustics", INT32_MAX));
     } else if (w == "caustic_lights") {
       Token t = lex_.next();
-      if (t.kind != TokenKind::Ident || (t.text != "vpl" && t.text != "spot"))
-        expected("\"vpl\" or \"spot\" for caustic_lights", t);
-      ir.causticLights = t.text;
+      std::optional<CausticLightKind> k =
+          t.kind == TokenKind::Ident ? findEnum(kCausticLightKindNames, t.text) : std::nullopt;
+      if (!k) expected(enumChoices(kCausticLightKindNames, "\"") + " for caustic_lights", t);
+      ir.causticLights = *k;
     } else {
       return false;
     }

@@ -237,7 +237,7 @@ class Writer {
     if (ir.caustics) out_ += "  caustics = " + std::to_string(*ir.caustics) + ";\n";
     if (ir.causticLights) {
       out_ += "  caustic_lights = ";
-      quoted(sanitizeName(*ir.causticLights));
+      quoted(causticLightKindName(*ir.causticLights));
       out_ += ";\n";
     }
     out_ += "}\n";

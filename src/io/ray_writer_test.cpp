@@ -108,6 +108,8 @@ void expectSameScene(const SceneDesc& a, const SceneDesc& b) {
     EXPECT_EQ(a.instantRadiosity->normalize, b.instantRadiosity->normalize);
     EXPECT_EQ(a.instantRadiosity->clamp, b.instantRadiosity->clamp);
     EXPECT_EQ(a.instantRadiosity->seed, b.instantRadiosity->seed);
+    EXPECT_EQ(a.instantRadiosity->caustics, b.instantRadiosity->caustics);
+    EXPECT_EQ(a.instantRadiosity->causticLights, b.instantRadiosity->causticLights);
   }
   ASSERT_EQ(a.environments.size(), b.environments.size());
   for (size_t i = 0; i < a.environments.size(); ++i) {
@@ -187,7 +189,7 @@ spot_light { position = (0, 3, 6); target = (0, 0, 0); color = (1, 0, 0); expone
   cone_angle = 30; penumbra = 10; cutoff_distance = 500; }
 spot_light { size = 50; blend = 0.15; direction = (0, -1, 0); }
 instant_radiosity { vpls = 5000; bounces = 2; normalize = "object"; clamp = 0.05; seed = 12345678901234567; }
-instant_radiosity { normalize = power; }
+instant_radiosity { normalize = power; caustics = 700; caustic_lights = "vpl"; }
 environment_light { map = "sky.exr"; colour = (1, 0.9, 0.8); intensity = 0.3; up = (0, 0, 1); rotate = 45; lights = 999; }
 sun_sky_light { direction = (0.1, -0.7, 0.2); turbidity = 2.5; intensity = 3; ground = (0.1, 0.2, 0.3); visible = false; }
 material = { name = shared; diffuse = (0.25, 0.5, 0.75); specular = map("spec.png"); shininess = 12.5; }

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "core/error.h"
 #include "core/math.h"
 
@@ -138,14 +139,28 @@ enum class VplNormalize {
   Power,   // energy conserving: each path carries its light's power / number of paths (default)
   Object,  // the seed's: a VPL's intensity divided by the number of VPLs on its object
 };
-// Each value and its name ("power", "object"), in the order the help and messages list them.
-inline constexpr std::pair<VplNormalize, const char*> kVplNormalizeNames[] = {{VplNormalize::Power, "power"},
-                                                                             {VplNormalize::Object, "object"}};
-const char* vplNormalizeName(VplNormalize v);
-std::optional<VplNormalize> findVplNormalize(std::string_view name);  // none for another name
-VplNormalize parseVplNormalize(const std::string& name);  // throws lc::Error for another name
-// The names joined by " or ", each in `quote` ("power or object", "\"power\" or \"object\"").
-std::string vplNormalizeChoices(const char* quote = "");
+// Its names (core/enum_names.h), in the order the help and messages list them.
+inline constexpr EnumName<VplNormalize> kVplNormalizeNames[] = {
+    {VplNormalize::Power, "power", "energy conserving"},
+    {VplNormalize::Object, "object", "the seed's per-object division"}};
+inline const char* vplNormalizeName(VplNormalize v) { return enumName(kVplNormalizeNames, v); }
+// Throws lc::Error for another name.
+inline VplNormalize parseVplNormalize(std::string_view name) {
+  return parseEnum(kVplNormalizeNames, name, "VPL normalisation");
+}
+
+// The model of a caustic light: instant_radiosity's `caustic_lights`, --caustic-lights,
+// lights::CausticOptions::kind (lights/caustics.h, which holds the default and describes
+// both models). Its one definition, here for the same reason as VplNormalize's.
+enum class CausticLightKind { Vpl, Spot };
+inline constexpr EnumName<CausticLightKind> kCausticLightKindNames[] = {
+    {CausticLightKind::Vpl, "vpl", "an oriented light lifted off the hit, facing it"},
+    {CausticLightKind::Spot, "spot", "the seed's: a spot at the last mirror or glass vertex"}};
+inline const char* causticLightKindName(CausticLightKind k) { return enumName(kCausticLightKindNames, k); }
+// Throws lc::Error for another name.
+inline CausticLightKind parseCausticLightKind(std::string_view name) {
+  return parseEnum(kCausticLightKindNames, name, "caustic light kind");
+}
 
 // instant_radiosity { vpls; bounces; normalize; clamp; seed; caustics; caustic_lights; }  (command line overrides)
 struct InstantRadiosityDesc {
@@ -155,7 +170,7 @@ struct InstantRadiosityDesc {
   std::optional<float> clamp;
   std::optional<uint64_t> seed;
   std::optional<int> caustics;                // light paths for caustic lights (lights/caustics.h)
-  std::optional<std::string> causticLights;  // "vpl" | "spot"
+  std::optional<CausticLightKind> causticLights;
   SourceLoc loc;
 };
 

@@ -19,7 +19,9 @@
 
 #include <cmath>
 #include <string>
+#include <string_view>
 
+#include "core/enum_names.h"
 #include "core/math.h"
 #include "lightcuts/light_tree.h"
 #include "lightcuts/shading.h"
@@ -27,8 +29,14 @@
 namespace lc::lightcuts {
 
 enum class Estimator { Representative, FirstOrder };
-Estimator parseEstimator(const std::string& name);  // "representative" | "first-order"
-const char* estimatorName(Estimator e);
+// Its names (core/enum_names.h), read by the functions below and by render --estimator.
+inline constexpr EnumName<Estimator> kEstimatorNames[] = {
+    {Estimator::FirstOrder, "first-order",
+     "its representative's, less the first-order change from the cluster's mean light, where smooth"},
+    {Estimator::Representative, "representative", "as published"}};
+// Throws lc::Error for another name.
+inline Estimator parseEstimator(std::string_view name) { return parseEnum(kEstimatorNames, name, "estimator"); }
+inline const char* estimatorName(Estimator e) { return enumName(kEstimatorNames, e); }
 
 // f(rep) minus the first-order change of f from the cluster's mean light (position mu,
 // normal n_mean) to the representative, with the gradient taken at the mean:

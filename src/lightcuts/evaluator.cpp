@@ -9,42 +9,6 @@
 
 namespace lc::lightcuts {
 
-Method parseMethod(const std::string& name) {
-  if (name == "brute") return Method::Brute;
-  if (name == "lightcuts") return Method::Lightcuts;
-  if (name == "seed" || name == "course") return Method::Course;
-  if (name == "stochastic") return Method::Stochastic;
-  throw Error("unknown method '" + name + "' (use brute, lightcuts, seed or stochastic)");
-}
-
-const char* methodName(Method m) {
-  switch (m) {
-    case Method::Brute: return "brute";
-    case Method::Lightcuts: return "lightcuts";
-    case Method::Course: return "seed";
-    case Method::Stochastic: return "stochastic";
-  }
-  return "?";
-}
-
-CutCriterion parseCutCriterion(const std::string& name) {
-  if (name == "walter") return CutCriterion::Walter;
-  if (name == "total") return CutCriterion::Total;
-  throw Error("unknown cut criterion '" + name + "' (use total or walter)");
-}
-
-const char* cutCriterionName(CutCriterion c) { return c == CutCriterion::Walter ? "walter" : "total"; }
-
-Estimator parseEstimator(const std::string& name) {
-  if (name == "representative") return Estimator::Representative;
-  if (name == "first-order") return Estimator::FirstOrder;
-  throw Error("unknown estimator '" + name + "' (use first-order or representative)");
-}
-
-const char* estimatorName(Estimator e) {
-  return e == Estimator::FirstOrder ? "first-order" : "representative";
-}
-
 namespace {
 
 // The total criterion bounds the root-sum-square of the cut's error spreads by this factor
@@ -54,7 +18,8 @@ namespace {
 // scaled by the point's boundary rate (below). The errors have random signs and sit
 // inside their spreads; with 1.6, at --error 0.02 over 99% of pixels come within 2% of
 // brute force on every scene of the benchmark (the church, whose emitters are mostly
-// hidden, is the hardest; docs/LIGHTCUTS.md has the figures).
+// hidden, is the hardest; docs/LIGHTCUTS.md has the figures). (The help states it too:
+// kCutCriterionNames, evaluator.h.)
 constexpr double kTotalFactor = 1.6;
 
 // Where a point sees few shadow boundaries, a first-order estimate of a cluster whose

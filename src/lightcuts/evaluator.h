@@ -19,12 +19,14 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "lightcuts/estimate.h"
 #include "lightcuts/eval_stats.h"
 #include "lightcuts/light_tree.h"
 #include "lightcuts/reconstruction.h"
 #include "lightcuts/shading.h"
+#include "core/enum_names.h"
 #include "core/light.h"
 
 namespace lc::lightcuts {
@@ -33,8 +35,18 @@ namespace lc::lightcuts {
 // Course: the course project's cuts this product grew from ("the seed", docs/SEED.md;
 // `--method seed` or `course`).
 enum class Method { Brute, Lightcuts, Course, Stochastic };
-Method parseMethod(const std::string& name);  // "brute" | "lightcuts" | "seed" (or "course") | "stochastic"
-const char* methodName(Method m);
+// Its names (core/enum_names.h: the first of a value its name, then aliases), in the order
+// render --method's help lists them; read by the functions below and by the CLI.
+inline constexpr EnumName<Method> kMethodNames[] = {
+    {Method::Lightcuts, "lightcuts", "Walter et al. 2005"},
+    {Method::Course, "seed", "the course project's cuts"},
+    {Method::Course, "course"},
+    {Method::Stochastic, "stochastic",
+     "stochastic lightcuts, Yuksel 2019: unbiased, noisy, no error bound; average with --spp"},
+    {Method::Brute, "brute"}};
+// Throws lc::Error for another name.
+inline Method parseMethod(std::string_view name) { return parseEnum(kMethodNames, name, "method"); }
+inline const char* methodName(Method m) { return enumName(kMethodNames, m); }
 
 // When a cut is good enough.
 //   Walter: every node's error bound is below errorRatio times the total estimate (Walter
@@ -48,8 +60,15 @@ const char* methodName(Method m);
 //     (evaluator.cpp). The errors of a cut have random signs, so this keeps the total
 //     error, not just each node's, near errorRatio.
 enum class CutCriterion { Walter, Total };
-CutCriterion parseCutCriterion(const std::string& name);  // "walter" | "total"
-const char* cutCriterionName(CutCriterion c);
+inline constexpr EnumName<CutCriterion> kCutCriterionNames[] = {
+    {CutCriterion::Total, "total",
+     "every bound below error x estimate and the root-sum-square of the error spreads below 1.6 x that"},
+    {CutCriterion::Walter, "walter", "every bound below error x estimate, as published"}};
+// Throws lc::Error for another name.
+inline CutCriterion parseCutCriterion(std::string_view name) {
+  return parseEnum(kCutCriterionNames, name, "cut criterion");
+}
+inline const char* cutCriterionName(CutCriterion c) { return enumName(kCutCriterionNames, c); }
 
 // The seed's traversal compares an error radius with the distance to the point, not a
 // relative bound, so its --error has its own default; the seed did not publish its value,

@@ -28,16 +28,6 @@ size_t LightForest::nodeCount() const {
   return n;
 }
 
-TreeBuilder parseTreeBuilder(const std::string& name) {
-  if (name == "walter" || name == "agglomerative") return TreeBuilder::Agglomerative;
-  if (name == "seed" || name == "course") return TreeBuilder::Course;
-  throw Error("unknown light tree builder '" + name + "' (use walter or seed)");
-}
-
-const char* treeBuilderName(TreeBuilder b) {
-  return b == TreeBuilder::Course ? "seed" : "walter";
-}
-
 void coneUnion(const Vec3& a, float cosA, const Vec3& b, float cosB, Vec3& axis, float& cosOut) {
   if (cosA <= -1 || cosB <= -1) {
     axis = a;

@@ -18,8 +18,10 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "core/huge_pages.h"
 #include "core/math.h"
 #include "core/progress.h"
@@ -94,6 +96,13 @@ struct LightTree {
 
 // Course: the course project's k-d split (`--tree seed` or `course`).
 enum class TreeBuilder { Agglomerative, Course };
+// Its names (core/enum_names.h: the first of a value its name, then aliases), read by the
+// functions below and by render --tree.
+inline constexpr EnumName<TreeBuilder> kTreeBuilderNames[] = {
+    {TreeBuilder::Agglomerative, "walter", "agglomerative"},
+    {TreeBuilder::Agglomerative, "agglomerative"},
+    {TreeBuilder::Course, "seed", "k-d split"},
+    {TreeBuilder::Course, "course"}};
 
 // Lights of one kind (type, diffuseOnly, isVpl) in more groups than this share one tree
 // (LightTree::mixedGroups): a tree per group would leave thousands of one-light trees, every
@@ -125,8 +134,11 @@ struct LightForest {
 // Builds one tree per (type, group) over the lights with non-zero intensity.
 LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& options = {});
 
-TreeBuilder parseTreeBuilder(const std::string& name);  // "walter" | "agglomerative" | "seed"
-const char* treeBuilderName(TreeBuilder b);
+// Throws lc::Error for another name.
+inline TreeBuilder parseTreeBuilder(std::string_view name) {
+  return parseEnum(kTreeBuilderNames, name, "light tree builder");
+}
+inline const char* treeBuilderName(TreeBuilder b) { return enumName(kTreeBuilderNames, b); }
 
 // ---- building blocks, exposed for tests ----
 

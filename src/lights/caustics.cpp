@@ -15,14 +15,6 @@
 
 namespace lc::lights {
 
-CausticLightKind parseCausticLightKind(const std::string& s) {
-  if (s == "vpl") return CausticLightKind::Vpl;
-  if (s == "spot") return CausticLightKind::Spot;
-  throw Error("unknown caustic light kind '" + s + "' (use vpl or spot)");
-}
-
-const char* causticLightKindName(CausticLightKind k) { return k == CausticLightKind::Spot ? "spot" : "vpl"; }
-
 namespace {
 
 // Caustic paths draw from streams apart from the VPLs' (which use (seed, path) with path < 2^63).

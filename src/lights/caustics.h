@@ -34,13 +34,14 @@
 #include <vector>
 
 #include "core/progress.h"
+#include "io/scene_desc.h"
 #include "scene/scene.h"
 
 namespace lc::lights {
 
-enum class CausticLightKind { Vpl, Spot };
-CausticLightKind parseCausticLightKind(const std::string& s);
-const char* causticLightKindName(CausticLightKind k);
+// The values, their names and their parsing: io/scene_desc.h (the scene's
+// instant_radiosity block and --caustic-lights share them).
+using io::CausticLightKind;
 
 struct CausticOptions {
   int paths = 0;  // --caustics: light paths shot (most miss the specular objects)

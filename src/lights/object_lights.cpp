@@ -87,18 +87,6 @@
 
 namespace lc::lights {
 
-ObjectLightKind parseObjectLightKind(const std::string& s) {
-  if (s == "oriented") return ObjectLightKind::Oriented;
-  if (s == "omni") return ObjectLightKind::Omni;
-  throw Error("unknown object light kind '" + s + "' (use oriented or omni)");
-}
-
-Placement parsePlacement(const std::string& s) {
-  if (s == "stratified") return Placement::Stratified;
-  if (s == "seed" || s == "course") return Placement::Course;
-  throw Error("unknown object light placement '" + s + "' (use stratified or seed)");
-}
-
 namespace {
 
 using io::ShapeKind;

@@ -5,8 +5,10 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "core/progress.h"
 #include "scene/scene.h"
 
@@ -21,8 +23,22 @@ enum class Placement {
   Course,      // the course project's (the seed's) pattern: centroid, then along centroid-vertex lines, then between
 };
 
-ObjectLightKind parseObjectLightKind(const std::string& s);
-Placement parsePlacement(const std::string& s);
+// Their names (core/enum_names.h: the first of a value its name, then aliases), read by the
+// parse and name functions and by --object-lights and --object-light-placement.
+inline constexpr EnumName<ObjectLightKind> kObjectLightKindNames[] = {
+    {ObjectLightKind::Oriented, "oriented", "cosine emission about the surface normal"},
+    {ObjectLightKind::Omni, "omni", "the seed's"}};
+inline constexpr EnumName<Placement> kPlacementNames[] = {
+    {Placement::Stratified, "stratified", "area-uniform low-discrepancy"},
+    {Placement::Course, "seed", "the seed's pattern"},
+    {Placement::Course, "course"}};
+inline const char* objectLightKindName(ObjectLightKind k) { return enumName(kObjectLightKindNames, k); }
+inline const char* placementName(Placement p) { return enumName(kPlacementNames, p); }
+// Throw lc::Error for another name.
+inline ObjectLightKind parseObjectLightKind(std::string_view s) {
+  return parseEnum(kObjectLightKindNames, s, "object light kind");
+}
+inline Placement parsePlacement(std::string_view s) { return parseEnum(kPlacementNames, s, "object light placement"); }
 
 struct ObjectLightOptions {
   ObjectLightKind kind = ObjectLightKind::Oriented;

@@ -4,8 +4,6 @@
 #include <gtest/gtest.h>
 
 #include "io/ray_parser.h"
-#include "lightcuts/bounds.h"
-#include "lightcuts/light_tree.h"
 
 namespace lc::lights {
 namespace {
@@ -76,25 +74,7 @@ TEST(Vpl, ClampIsTheAttenuationOfEveryMethod) {
   float I = v.intensity.x * dc * dc;
   for (float d : {0.1f * dc, 0.5f * dc, dc, 2 * dc, 10 * dc})
     EXPECT_NEAR(v.intensity.x * g.atten(d), I * std::min(1 / (dc * dc), 1 / (d * d)), 1e-5f * I / (dc * dc));
-  // The Lightcuts bound of a one-VPL cluster uses the same attenuation: it is >= the exact value.
-  lightcuts::LightNode node{};
-  node.lo = node.hi = v.position;
-  node.axis = v.direction;
-  node.cosHalfAngle = 1;
-  node.intensity = v.intensity;
-  lightcuts::ShadingPoint sp;
-  sp.p = v.position + v.direction * (0.3f * dc) + Vec3(0.01f, 0.02f, 0.0f);
-  sp.n = -v.direction;
-  sp.r = sp.n;
-  sp.kd = Color(1);
-  Color mg;
-  Vec3 wi;
-  float dist;
-  ASSERT_TRUE(lightcuts::lightContribution(v, g, sp, mg, wi, dist));
-  Color exact = mg * v.intensity;
-  Color bound = lightcuts::clusterBound(node, LightType::Oriented, g, sp, lightcuts::BoundFrames(sp));
-  EXPECT_GE(bound.x, exact.x);
-  EXPECT_LE(bound.x, exact.x * 1.01f);  // and tight for one light
+  // The Lightcuts bound uses the same attenuation: render/vpl_bound_test.cpp.
 }
 
 TEST(Vpl, SeedNormalisationDividesByVplsOnTheObject) {

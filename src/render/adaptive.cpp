@@ -1,5 +1,7 @@
 #include "render/adaptive.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -8,12 +10,10 @@
 
 namespace lc::render {
 
-const char* antiAliasingName(AntiAliasing aa) { return aa == AntiAliasing::Adaptive ? "adaptive" : "off"; }
-
-AntiAliasing parseAntiAliasing(const std::string& name) {
-  if (name == "adaptive") return AntiAliasing::Adaptive;
-  if (name == "off") return AntiAliasing::Off;
-  throw Error("unknown antialiasing '" + name + "' (use adaptive or off)");
+std::string antiAliasingHelp(const RenderOptions& o) {
+  return fmt::format(fmt::runtime(enumHelp(kAntiAliasingNames)),
+                     fmt::arg("normal_degrees", std::acos(o.aaNormalCos) * 180 / kPi),
+                     fmt::arg("contrast_percent", 100 * o.aaContrast));
 }
 
 bool disagree(const CentreSample& a, const CentreSample& b, const RenderOptions& o) {

@@ -102,7 +102,7 @@ TEST(Caustics, BallLensFocusesAtLeastThreeTimesTheBareFloor) {
           ++count;
         }
     double spot = sum / count;
-    EXPECT_GE(spot, 3 * floorOnly) << lights::causticLightKindName(k);
+    EXPECT_GE(spot, 3 * floorOnly) << io::causticLightKindName(k);
     // Outside the sphere's shadow the floor is lit directly, as without it.
     EXPECT_NEAR(floorValue(*s, *ev, 3, 0).x, floorValue(*bare, *bareEv, 3, 0).x, 0.01f * floorOnly);
   }
@@ -136,7 +136,7 @@ translate(0, 1, 0, scale(3, 0.2, 3, box { material = { transmissive = (0.9, 0.9,
         sum += floorValue(*s, *ev, x, z).x;
         ++count;
       }
-    EXPECT_NEAR(sum / count, 0.81, 0.81 * 0.04) << lights::causticLightKindName(k);
+    EXPECT_NEAR(sum / count, 0.81, 0.81 * 0.04) << io::causticLightKindName(k);
     // Outside the slab: the directional light alone.
     EXPECT_NEAR(floorValue(*s, *ev, 1.9f, 1.9f).x, 1.0f, 0.02f);
   }
@@ -182,9 +182,9 @@ TEST(Caustics, BallLensConvergesToPhotonSplattingReference) {
   };
   for (CausticLightKind k : {CausticLightKind::Vpl, CausticLightKind::Spot}) {
     double coarse = ringError(125'000, k), fine = ringError(1'000'000, k);
-    RecordProperty(std::string("ring_error_125k_") + lights::causticLightKindName(k), std::to_string(coarse));
-    RecordProperty(std::string("ring_error_1m_") + lights::causticLightKindName(k), std::to_string(fine));
-    std::printf("%s: relative ring error %.3f at 125k paths, %.3f at 1M\n", lights::causticLightKindName(k), coarse,
+    RecordProperty(std::string("ring_error_125k_") + io::causticLightKindName(k), std::to_string(coarse));
+    RecordProperty(std::string("ring_error_1m_") + io::causticLightKindName(k), std::to_string(fine));
+    std::printf("%s: relative ring error %.3f at 125k paths, %.3f at 1M\n", io::causticLightKindName(k), coarse,
                 fine);
     EXPECT_LT(fine, coarse);
     EXPECT_LT(fine, 0.15);
@@ -229,7 +229,7 @@ TEST(Caustics, RayKeysAndTheirErrors) {
                                        "scene.ray", "");
   ASSERT_TRUE(d.instantRadiosity);
   EXPECT_EQ(d.instantRadiosity->caustics, 5000);
-  EXPECT_EQ(d.instantRadiosity->causticLights, "spot");
+  EXPECT_EQ(d.instantRadiosity->causticLights, CausticLightKind::Spot);
   auto message = [](const std::string& text) {
     try {
       io::parseRayString(text, "scene.ray", "");
@@ -242,7 +242,8 @@ TEST(Caustics, RayKeysAndTheirErrors) {
   std::string m = message("SBT-raytracer 1.0\ninstant_radiosity {\n  caustic_lights = photon; }\n");
   EXPECT_NE(m.find("scene.ray:3:20:"), std::string::npos) << m;
   EXPECT_NE(m.find("\"vpl\" or \"spot\""), std::string::npos) << m;
-  EXPECT_THROW(lights::parseCausticLightKind("photon"), Error);
+  EXPECT_THROW(io::parseCausticLightKind("photon"), Error);
+  EXPECT_EQ(io::parseCausticLightKind("vpl"), CausticLightKind::Vpl);
 }
 
 }  // namespace

@@ -10,8 +10,10 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
+#include "core/enum_names.h"
 #include "core/progress.h"
 #include "io/image.h"
 #include "lightcuts/evaluator.h"
@@ -27,9 +29,20 @@ enum class AntiAliasing {
   Adaptive,  // the centre, then more samples only where neighbouring centres disagree
 };
 
-// "adaptive", "off" and back; parse throws lc::Error on other names.
-const char* antiAliasingName(AntiAliasing aa);
-AntiAliasing parseAntiAliasing(const std::string& name);
+// Its names (core/enum_names.h), read by the functions below and by render --aa. Adaptive's
+// words name RenderOptions' thresholds, {normal_degrees} and {contrast_percent}, which
+// antiAliasingHelp fills in.
+inline constexpr EnumName<AntiAliasing> kAntiAliasingNames[] = {
+    {AntiAliasing::Adaptive, "adaptive",
+     "a pixel whose centre ray differs from a neighbour's in shape, in normal by more than {normal_degrees:.0f} "
+     "degrees, or in luminance by more than {contrast_percent:g}% is re-sampled with --aa-samples stratified "
+     "sub-samples"},
+    {AntiAliasing::Off, "off", "the pixel centre only"}};
+inline const char* antiAliasingName(AntiAliasing aa) { return enumName(kAntiAliasingNames, aa); }
+// Throws lc::Error for another name.
+inline AntiAliasing parseAntiAliasing(std::string_view name) {
+  return parseEnum(kAntiAliasingNames, name, "antialiasing");
+}
 
 struct RenderOptions {
   int width = 512;
@@ -95,6 +108,9 @@ struct RenderOptions {
   // app/distributed.h); null: every tile and reference pixel is rendered here.
   WorkShare* share = nullptr;
 };
+
+// The help's list of the antialiasing modes (enumHelp), with o's thresholds.
+std::string antiAliasingHelp(const RenderOptions& o = {});
 
 struct ReferenceStats {
   int pixels = 0;
