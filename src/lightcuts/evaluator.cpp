@@ -277,9 +277,8 @@ class Lightcuts final : public LightEvaluator {
       ++cutRoots;
     }
     // The budget grows by one node per tree after the first: a forest of more trees than
-    // --max-cut (a scene whose lights all differ in attenuation or cone, one tree each)
-    // still refines its large trees. Stopping at the roots left a 15,000-light tree as one representative (errors of
-    // 1,000% on a scene of 15,000 spots with their own cone angles).
+    // --max-cut still refines its large trees. Stopping at the roots left a 15,000-light
+    // tree as one representative (errors of 1,000% beside 15,000 one-spot trees).
     const uint32_t maxCut = uint32_t(opt_.maxCut) + std::max(cutRoots, 1u) - 1;
     const float eps = opt_.errorRatio;
     const double rssFactor2 = kTotalFactor * kTotalFactor;

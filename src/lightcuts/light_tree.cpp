@@ -381,10 +381,13 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
       t.mixedGroups = true;
       t.group = lights.lights[idx.front()].group;
       t.bound = t.boundLow = lights.groups[t.group];
+      // The lights come group after group (concatenated above): each group once.
+      uint16_t last = t.group;
       for (uint32_t li : idx) {
-        const LightGroup& g = lights.groups[lights.lights[li].group];
-        t.bound = upperEnvelope(t.bound, g);
-        t.boundLow = lowerEnvelope(t.boundLow, g);
+        if (lights.lights[li].group == last) continue;
+        last = lights.lights[li].group;
+        t.bound = upperEnvelope(t.bound, lights.groups[last]);
+        t.boundLow = lowerEnvelope(t.boundLow, lights.groups[last]);
       }
     }
     forest.trees[i] = std::move(t);

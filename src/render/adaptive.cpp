@@ -85,14 +85,14 @@ bool shadeEverySubSample(const scene::Material& m) {
 // sub-sample's primary ray finds which surface it sees, but on a plain diffuse or glossy
 // surface only the first sub-sample of that surface in each cell of a 3 x 3 grid over the
 // pixel is shaded, and the others take the radiance of the nearest shaded one on the same
-// surface (a shape and a normal within aaNormalCos; the pixel's centre, `centre`, counts as
-// shaded). An edge
-// pixel's error is mostly which surface covers how much of it, which 48 rays measure for
-// the price of a few shadings; light varies little across one surface within a pixel.
+// surface (the pixel's centre, of radiance `centre`, counts as shaded). An edge pixel's
+// error is mostly which surface covers how much of it, which 48 rays measure for the price
+// of a few shadings; light varies little across one surface within a pixel, and where it
+// does (the shaded samples disagree) the surface is shaded at every sub-sample.
 SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightEvaluator& ev, const RenderOptions& o,
                               int x, int y, int g, lightcuts::EvalStats& stats, uint64_t& primary,
                               uint64_t& secondary, const ReconstructionTile* rt, AaCutCache* cache,
-                              int centreShape, const Vec3& centreNormal, const Color& centre) {
+                              const Color& centre) {
   SubSampleSums sums;
   Rng rng(o.seed, aaStream(x, y, o.width, o.height));
   const scene::Camera& cam = scene.camera();
@@ -100,7 +100,7 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
   struct Sub {
     Vec2 u;
     scene::Ray ray;
-    int shape = -1;
+    bool hit = false;
     int surface = -1;  // index into `surfaces`
     bool shade = true;
     Color c{0};
@@ -121,11 +121,11 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
     const scene::Material* m;
   };
   std::vector<Surface> surfaces;
-  {
+  if (decouple) {
     scene::Hit h;
     const scene::Ray c{cam.eye, normalize(cam.direction((float(x) + 0.5f) / float(o.width), (float(y) + 0.5f) / float(o.height))),
                        0, kInf};
-    const bool hit = centreShape >= 0 && scene.intersect(c, h);
+    const bool hit = scene.intersect(c, h);
     surfaces.push_back(Surface{hit, h.p, h.ns, h.t, hit ? &scene.materialOf(h) : nullptr});
   }
   auto same = [&](const Surface& a, bool hit, const scene::Hit& h, const scene::Material* m) {
@@ -146,16 +146,16 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
                        0, kInf};
     if (!decouple) continue;
     scene::Hit hit;
-    if (scene.intersect(b.ray, hit)) b.shape = hit.shape;
+    b.hit = scene.intersect(b.ray, hit);
     ++primary;
-    const scene::Material* m = b.shape >= 0 ? &scene.materialOf(hit) : nullptr;
+    const scene::Material* m = b.hit ? &scene.materialOf(hit) : nullptr;
     for (size_t k = 0; k < surfaces.size() && b.surface < 0; ++k)
-      if (same(surfaces[k], b.shape >= 0, hit, m)) b.surface = int(k);
+      if (same(surfaces[k], b.hit, hit, m)) b.surface = int(k);
     if (b.surface < 0) {
       b.surface = int(surfaces.size());
-      surfaces.push_back(Surface{b.shape >= 0, hit.p, hit.ns, hit.t, m});
+      surfaces.push_back(Surface{b.hit, hit.p, hit.ns, hit.t, m});
     }
-    if (b.shape >= 0 && shadeEverySubSample(scene.materialOf(hit))) continue;
+    if (m && shadeEverySubSample(*m)) continue;
     const int cell = std::min(2, int(b.u.x * 3)) + 3 * std::min(2, int(b.u.y * 3));
     const std::pair<int, int> key{cell, b.surface};
     if (std::find(shadedInCell.begin(), shadedInCell.end(), key) != shadedInCell.end()) {
@@ -273,9 +273,8 @@ void adaptiveTile(const scene::Scene& scene, const lightcuts::LightEvaluator& ev
       if (!flags[size_t(y - y0) * size_t(w) + size_t(x - x0)]) continue;
       if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
       size_t i = size_t(y) * size_t(o.width) + size_t(x);
-      const CentreSample& cs = ring[size_t(y - y0 + 1) * size_t(w + 2) + size_t(x - x0 + 1)];
       SubSampleSums sub = traceSubSamples(scene, ev, o, x, y, g, counters.stats, counters.primary,
-                                          counters.secondary, rt, cache, cs.shape, cs.n, res.image.pixels[i]);
+                                          counters.secondary, rt, cache, res.image.pixels[i]);
       res.image.pixels[i] = (res.image.pixels[i] + sub.color) / n;
       // Per shading: the samples that took another's radiance cost no cut.
       const double shadings = 1.0 + sub.shaded;
@@ -294,12 +293,7 @@ Color pixelWithSubSamples(const scene::Scene& scene, const lightcuts::LightEvalu
   Color c = renderPixel(scene, ev, o, x, y, stats, a, b).color;
   if (!res.aaFlagged[size_t(y) * size_t(o.width) + size_t(x)]) return c;
   const int g = aaGridSide(o.aaSamples);
-  const scene::Camera& cam = scene.camera();
-  scene::Ray ray{cam.eye, normalize(cam.direction((float(x) + 0.5f) / float(o.width), (float(y) + 0.5f) / float(o.height))),
-                 0, kInf};
-  scene::Hit hit;
-  const int centreShape = scene.intersect(ray, hit) ? hit.shape : -1;
-  SubSampleSums sub = traceSubSamples(scene, ev, o, x, y, g, stats, a, b, nullptr, nullptr, centreShape, hit.ns, c);
+  SubSampleSums sub = traceSubSamples(scene, ev, o, x, y, g, stats, a, b, nullptr, nullptr, c);
   return (c + sub.color) / float(g * g);
 }
 
