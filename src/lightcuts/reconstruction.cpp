@@ -26,15 +26,20 @@ inline float distance2Box(const LightNode& n, const Vec3& p) {
 constexpr uint8_t kFirstOrderBit = 4;
 constexpr uint8_t kStateMask = 7;  // visibility and kFirstOrderBit
 
+// A node of the walk with, per sample i, byte i of `state`: kAbove, or the CutVisibility it
+// inherits, with kFirstOrderBit when that cut node used its first-order estimate (then so
+// may every node below it: a part of a cluster over which the contribution is smooth is
+// smooth too). One 32-bit word, not a byte array: the walk keeps it in a register (as
+// bytes in memory, each push read back what it had just written byte by byte, a
+// store-forwarding stall that was a fifth of the merge, perf on the church).
 struct Item {
   uint32_t node;
-  // Per sample: kAbove, or the CutVisibility it inherits, with kFirstOrderBit when that
-  // cut node used its first-order estimate (then so may every node below it: a part of
-  // a cluster over which the contribution is smooth is smooth too).
-  uint8_t state[kMaxSamples];
-  // Bit i: sample i's cut holds this very node (its entry is the one before its cursor).
-  uint8_t exact;
+  uint32_t state;
 };
+inline uint8_t stateOf(uint32_t state, int i) { return uint8_t(state >> (8 * i)); }
+inline void setState(uint32_t& state, int i, uint8_t v) {
+  state = (state & ~(0xffu << (8 * i))) | uint32_t(v) << (8 * i);
+}
 
 }  // namespace
 
@@ -69,25 +74,32 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       end[i] = samples[i]->treeBegin[t + 1];
     }
     stack.clear();
-    stack.push_back(Item{0, {kAbove, kAbove, kAbove, kAbove}, 0});
-    while (!stack.empty()) {
-      Item it = stack.back();
-      stack.pop_back();
+    Item it{0, 0xffffffffu};  // the root, kAbove for every sample
+    bool descending = true;   // `it` is the left child just reached, not yet on the stack
+    for (;;) {
+      if (!descending) {
+        if (stack.empty()) break;
+        it = stack.back();
+        stack.pop_back();
+      }
+      descending = false;
+      // Bit i: sample i's cut holds this very node (its entry is the one before its cursor).
+      uint32_t exact = 0;
       const LightNode& n = tree.nodes[it.node];
       const uint32_t pre = tree.preorder[it.node];
       bool above = false;
       for (int i = 0; i < count; ++i) {
-        if (it.state[i] != kAbove) continue;
+        if (stateOf(it.state, i) != kAbove) continue;
         const uint32_t* e = samples[i]->entries.data();
         uint32_t c = cursor[i];
         while (c < end[i] && CutRecord::preorderOf(e[c]) < pre) ++c;  // skips nodes of subtrees not walked
         if (c < end[i] && CutRecord::preorderOf(e[c]) == pre) {
-          it.state[i] = uint8_t(uint8_t(CutRecord::visibilityOf(e[c])) |
-                                (CutRecord::firstOrderOf(e[c]) ? kFirstOrderBit : 0));
-          it.exact |= uint8_t(1u << i);
+          setState(it.state, i, uint8_t(uint8_t(CutRecord::visibilityOf(e[c])) |
+                                        (CutRecord::firstOrderOf(e[c]) ? kFirstOrderBit : 0)));
+          exact |= 1u << i;
           ++c;
         } else if (n.isLeaf() || c >= end[i]) {
-          it.state[i] = uint8_t(CutVisibility::Untested);  // a record of another forest
+          setState(it.state, i, uint8_t(CutVisibility::Untested));  // a record of another forest
         } else {
           above = true;
         }
@@ -102,15 +114,15 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         const uint32_t last = pre + 2 * tree.lightCount(it.node) - 1;  // the subtree's preorder range
         uint32_t past[kMaxSamples];  // per refining sample: its first entry after the subtree
         for (int i = 0; i < count && ok; ++i) {
-          if (it.state[i] == kAbove) continue;
-          kept |= it.state[i] == vf && (it.exact >> i & 1);
-          ok = it.state[i] == vf;
+          if (stateOf(it.state, i) == kAbove) continue;
+          kept |= stateOf(it.state, i) == vf && (exact >> i & 1);
+          ok = stateOf(it.state, i) == vf;
         }
         // ... as long as the samples are close together seen from the cluster: the coarser
         // cut was chosen for the sample that kept it.
         ok = ok && kept && distance2Box(n, samples[0]->point) >= kCoarsenRatio2 * spread2;
         for (int i = 0; i < count && ok; ++i) {
-          if (it.state[i] != kAbove) continue;
+          if (stateOf(it.state, i) != kAbove) continue;
           const uint32_t* e = samples[i]->entries.data();
           past[i] = uint32_t(std::lower_bound(e + cursor[i], e + end[i], last,
                                               [](uint32_t en, uint32_t p) { return CutRecord::preorderOf(en) < p; }) - e);
@@ -118,32 +130,32 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         }
         if (ok) {
           for (int i = 0; i < count; ++i) {
-            if (it.state[i] != kAbove) continue;
+            if (stateOf(it.state, i) != kAbove) continue;
             cursor[i] = past[i];
-            it.state[i] = vf;
+            setState(it.state, i, vf);
           }
           above = false;
         }
       }
       if (above) {
-        it.exact = 0;  // the children inherit states, not the entries
-        Item r = it;
-        r.node = n.left + 1;
-        stack.push_back(r);
-        it.node = n.left;
-        stack.push_back(it);  // left on top: the walk stays in preorder
+        // The children inherit states, not the entries (their `exact` starts at 0).
+        __builtin_prefetch(&tree.nodes[n.left]);
+        __builtin_prefetch(&tree.preorder[n.left]);
+        stack.push_back(Item{n.left + 1, it.state});
+        it.node = n.left;  // the left child next: the walk stays in preorder
+        descending = true;
         continue;
       }
-      int visible = 0, occluded = 0, partial = 0, firstOrder = 0, exact = 0;
+      int visible = 0, occluded = 0, partial = 0, firstOrder = 0, exacts = 0;
       float factorSum = 0;
       for (int i = 0; i < count; ++i) {
-        firstOrder += (it.state[i] & kFirstOrderBit) != 0;
-        if (it.exact >> i & 1) {
+        firstOrder += (stateOf(it.state, i) & kFirstOrderBit) != 0;
+        if (exact >> i & 1) {
           const std::vector<float>& f = samples[i]->factor;
-          ++exact;
+          ++exacts;
           factorSum += cursor[i] - 1 < f.size() ? f[cursor[i] - 1] : 1.0f;
         }
-        auto s = CutVisibility(it.state[i] & 3);
+        auto s = CutVisibility(stateOf(it.state, i) & 3);
         visible += s == CutVisibility::Visible;
         occluded += s == CutVisibility::Occluded;
         partial += s == CutVisibility::Partial;
@@ -154,13 +166,25 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       }
       bool needsRay = occluded > 0 || partial > 0 || visible == 0;
       const bool disagree = occluded > 0 || partial > 0;
-      const float factor = firstOrder == count && exact > 0 ? factorSum / float(exact) : 1.0f;
+      const float factor = firstOrder == count && exacts > 0 ? factorSum / float(exacts) : 1.0f;
       const bool batched = !needsRay && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
-      if (batched) {
-        out.batch.add(lights.lights[n.rep], lights.groups[lights.lights[n.rep].group], n.intensity * factor);
-        out.batchNodes.push_back(uint32_t(out.nodes.size()));
-      }
-      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, lights.lights[n.rep].group, needsRay, batched, disagree, factor, t, it.node});
+      // The group and the batch wait for the pass below, which fetches the lights ahead.
+      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, 0, needsRay, batched, disagree, factor, t, it.node});
+    }
+  }
+  // The representatives' lights are scattered over the light array: a cache miss each when
+  // read as the walk meets them, so they are fetched a few nodes ahead here.
+  constexpr size_t kAhead = 8;
+  const size_t count_ = out.nodes.size();
+  for (size_t i = 0; i < std::min(kAhead, count_); ++i) __builtin_prefetch(&lights.lights[out.nodes[i].rep]);
+  for (size_t i = 0; i < count_; ++i) {
+    if (i + kAhead < count_) __builtin_prefetch(&lights.lights[out.nodes[i + kAhead].rep]);
+    MergedCut::Node& node = out.nodes[i];
+    const Light& rep = lights.lights[node.rep];
+    node.group = rep.group;
+    if (node.batched) {
+      out.batch.add(rep, lights.groups[rep.group], node.intensity * node.factor);
+      out.batchNodes.push_back(uint32_t(i));
     }
   }
   for (size_t g = 0; g < out.batchNodes.size(); g += MergedCut::kGroupSize) {
