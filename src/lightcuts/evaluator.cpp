@@ -1,6 +1,8 @@
 #include "lightcuts/evaluator.h"
 
 #include <algorithm>
+#include <bit>
+#include <utility>
 #include <cstring>
 #include <vector>
 
@@ -10,6 +12,37 @@
 namespace lc::lightcuts {
 
 namespace {
+
+// Sorts a cut's recorded entries (tree << 32 | CutRecord entry, and a factor) by key: by
+// tree, then preorder, unique per entry. For a cut of a thousand nodes std::sort was 4% of
+// the church's render (perf); a radix sort over the key's significant bits, the tree above
+// the preorder (the entry's 3 low bits are payload), takes two or three passes.
+void sortRecorded(std::vector<std::pair<uint64_t, float>>& v) {
+  if (v.size() < 256) {
+    std::sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    return;
+  }
+  uint32_t maxTree = 0, maxPre = 0;
+  for (const auto& e : v) {
+    maxTree = std::max(maxTree, uint32_t(e.first >> 32));
+    maxPre = std::max(maxPre, CutRecord::preorderOf(uint32_t(e.first)));
+  }
+  const int preBits = std::bit_width(maxPre), bits = preBits + std::bit_width(maxTree);
+  auto compact = [preBits](uint64_t k) { return (k >> 32) << preBits | CutRecord::preorderOf(uint32_t(k)); };
+  constexpr int kDigit = 10;
+  constexpr uint32_t kMask = (1u << kDigit) - 1;
+  static thread_local std::vector<std::pair<uint64_t, float>> tmp;
+  tmp.resize(v.size());
+  uint32_t count[1u << kDigit];
+  for (int shift = 0; shift < bits; shift += kDigit) {
+    std::fill(std::begin(count), std::end(count), 0u);
+    for (const auto& e : v) ++count[compact(e.first) >> shift & kMask];
+    uint32_t sum = 0;
+    for (uint32_t& c : count) sum += std::exchange(c, sum);
+    for (const auto& e : v) tmp[count[compact(e.first) >> shift & kMask]++] = e;
+    v.swap(tmp);
+  }
+}
 
 // The total criterion bounds the root-sum-square of the cut's error spreads by this factor
 // times errorRatio. A node's spread is its upper bound, or, when its representative is
@@ -392,7 +425,7 @@ class Lightcuts final : public LightEvaluator {
     }
     if (record) {
       // The cut: the nodes left in the heap, and the exact ones recorded as they came.
-      std::sort(recorded.begin(), recorded.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      sortRecorded(recorded);
       record->clear();
       record->valid = true;
       record->point = sp.p;

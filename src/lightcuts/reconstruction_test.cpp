@@ -95,6 +95,47 @@ TEST(Reconstruction, RecordedCutIsThePartitionTheLightcutUsed) {
   EXPECT_EQ(leaves, f.lights.lights.size());
 }
 
+// Large cuts are sorted by another path (a radix sort from 256 entries up): the record of
+// a cut of thousands of nodes over two trees is still each tree's partition, in preorder.
+TEST(Reconstruction, LargeRecordedCutIsInPreorderPerTree) {
+  LightSet lights = cloud(4000, LightType::Omni, 5);
+  LightSet oriented = cloud(4000, LightType::Oriented, 6);
+  for (const Light& l : oriented.lights) lights.lights.push_back(l);
+  LightForest forest = buildLightForest(lights);
+  ASSERT_EQ(forest.trees.size(), 2u);
+  CutOptions fine;
+  fine.errorRatio = 0.0005f;
+  fine.maxCut = 100000;
+  std::unique_ptr<LightEvaluator> lc = makeLightcuts(lights, forest, fine);
+  CountingVisibility v(halfBlocked);
+  EvalStats st;
+  CutRecord r;
+  EvalResult e = lc->evaluateRecorded(point(Vec3(0.2f, 0, 0.1f)), v, st, r);
+  ASSERT_TRUE(r.valid);
+  ASSERT_GE(r.entries.size(), 1000u);
+  EXPECT_EQ(r.entries.size(), e.cutSize);
+  ASSERT_EQ(r.treeBegin.size(), 3u);
+  EXPECT_EQ(r.treeBegin[0], 0u);
+  EXPECT_EQ(r.treeBegin[2], r.entries.size());
+  size_t leavesTotal = 0;
+  for (uint32_t t = 0; t < 2; ++t) {
+    const LightTree& tree = forest.trees[t];
+    std::vector<uint32_t> byPre(tree.nodes.size());
+    for (uint32_t i = 0; i < tree.nodes.size(); ++i) byPre[tree.preorder[i]] = i;
+    uint32_t next = 0, leaves = 0;
+    for (uint32_t k = r.treeBegin[t]; k < r.treeBegin[t + 1]; ++k) {
+      const uint32_t pre = CutRecord::preorderOf(r.entries[k]);
+      ASSERT_LT(pre, tree.nodes.size());
+      EXPECT_GE(pre, next) << "tree " << t << ": out of order or overlapping at entry " << k;
+      next = pre + subtreeSize(tree, byPre[pre]);
+      leaves += test_lights::leafCount(tree, byPre[pre]);
+    }
+    EXPECT_EQ(leaves, tree.lightCount(0)) << "tree " << t;
+    leavesTotal += leaves;
+  }
+  EXPECT_EQ(leavesTotal, lights.lights.size());
+}
+
 TEST(Reconstruction, ASampleRebuildsItsOwnLightcutWithoutShadowRays) {
   Fixture f;
   ShadingPoint sp = point(Vec3(0.2f, 0, 0.1f));
