@@ -12,7 +12,6 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -31,11 +30,12 @@
 
 #include "core/math.h"
 #include "io/image.h"
+#include "child_process.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
 using lc::testing::TempDir;
-using lc::testing::binary;
+using lc::testing::filesIn;
 using lc::testing::slurp;
 
 namespace {
@@ -47,90 +47,11 @@ void writeText(const std::string& path, const std::string& text) {
   out << text;
 }
 
-// A running `lightcuts` process with stdout/stderr captured to files in `dir`.
-class Child {
+// A running `lightcuts ARGS` process in `dir`, stdout/stderr captured to files there.
+class Child : public lc::testing::ChildProcess {
  public:
-  Child(const std::vector<std::string>& args, const std::string& dir) : dir_(dir) {
-    outPath_ = dir + "/.stdout";
-    errPath_ = dir + "/.stderr";
-    start_ = Clock::now();
-    pid_ = fork();
-    if (pid_ == 0) {
-      if (chdir(dir.c_str()) != 0) _exit(126);
-      int o = open(outPath_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      int e = open(errPath_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      if (o < 0 || e < 0) _exit(126);
-      dup2(o, 1);
-      dup2(e, 2);
-      int null = open("/dev/null", O_RDONLY);
-      if (null >= 0) dup2(null, 0);
-      std::string bin = binary();
-      std::vector<char*> argv{bin.data()};
-      std::vector<std::string> copy = args;
-      for (std::string& a : copy) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(bin.c_str(), argv.data());
-      _exit(127);
-    }
-  }
-  ~Child() {
-    if (pid_ > 0 && !reaped_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-
-  // Waits up to `seconds`; false on timeout (the process is then killed).
-  bool wait(double seconds) {
-    auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
-    for (;;) {
-      int st = 0;
-      pid_t r = waitpid(pid_, &st, WNOHANG);
-      if (r == pid_) {
-        reaped_ = true;
-        end_ = Clock::now();
-        if (WIFEXITED(st)) status_ = WEXITSTATUS(st);
-        if (WIFSIGNALED(st)) signal_ = WTERMSIG(st);
-        return true;
-      }
-      if (Clock::now() > deadline) {
-        kill(pid_, SIGKILL);
-        waitpid(pid_, nullptr, 0);
-        reaped_ = true;
-        return false;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-  }
-  // Polls stderr until it contains `text`; false when the process ends first or on timeout.
-  bool waitForStderr(const std::string& text, double seconds) {
-    auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
-    while (Clock::now() < deadline) {
-      if (stderrText().find(text) != std::string::npos) return true;
-      int st = 0;
-      if (waitpid(pid_, &st, WNOHANG) == pid_) {
-        reaped_ = true;
-        if (WIFEXITED(st)) status_ = WEXITSTATUS(st);
-        if (WIFSIGNALED(st)) signal_ = WTERMSIG(st);
-        return false;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return false;
-  }
-  void signal(int sig) { kill(pid_, sig); }
-
-  int status() const { return status_; }
-  int termSignal() const { return signal_; }
-  std::string stdoutText() const { return slurp(outPath_); }
-  std::string stderrText() const { return slurp(errPath_); }
-
- private:
-  std::string dir_, outPath_, errPath_;
-  pid_t pid_ = -1;
-  bool reaped_ = false;
-  int status_ = -1, signal_ = 0;
-  Clock::time_point start_, end_;
+  Child(const std::vector<std::string>& args, const std::string& dir)
+      : ChildProcess(lc::testing::lightcutsCommand(args), dir) {}
 };
 
 struct CliResult {
@@ -149,16 +70,6 @@ CliResult run(const std::vector<std::string>& args, const std::string& dir, doub
   r.out = c.stdoutText();
   r.err = c.stderrText();
   return r;
-}
-
-// The files in `dir` other than the captured output.
-std::set<std::string> filesIn(const std::string& dir) {
-  std::set<std::string> s;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    std::string n = e.path().filename().string();
-    if (n != ".stdout" && n != ".stderr") s.insert(n);
-  }
-  return s;
 }
 
 const std::string kHeader = "SBT-raytracer 1.0\n";

@@ -8,10 +8,8 @@
 // CMake). CI runs as root: mpirun needs --allow-run-as-root and the OMPI_ALLOW_RUN_AS_ROOT
 // variables. Under the sanitizer build (make test-sanitize) LeakSanitizer's reports of
 // Open MPI's own allocations are suppressed (tests/lsan_mpi.supp).
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -20,16 +18,17 @@
 #include <fstream>
 #include <set>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "child_process.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
+using lc::testing::ChildProcess;
 using lc::testing::TempDir;
-using lc::testing::binary;
+using lc::testing::filesIn;
 using lc::testing::scenePath;
 using lc::testing::slurp;
 
@@ -67,79 +66,12 @@ void prepareEnvironment() {
 }
 
 // `mpirun -np K lightcuts ARGS` (K = 0: lightcuts alone) in `dir`, output captured.
-class Job {
- public:
-  Job(int ranks, const std::vector<std::string>& args, const std::string& dir) {
-    prepareEnvironment();
-    errPath_ = dir + "/.stderr";
-    outPath_ = dir + "/.stdout";
-    std::vector<std::string> argv;
-    if (ranks > 0)
-      argv = {mpiexec(), "--allow-run-as-root", "--oversubscribe", "-np", std::to_string(ranks)};
-    argv.push_back(binary());
-    argv.insert(argv.end(), args.begin(), args.end());
-    pid_ = fork();
-    if (pid_ == 0) {
-      if (chdir(dir.c_str()) != 0) _exit(126);
-      int o = open(outPath_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      int e = open(errPath_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      if (o < 0 || e < 0) _exit(126);
-      dup2(o, 1);
-      dup2(e, 2);
-      int null = open("/dev/null", O_RDONLY);
-      if (null >= 0) dup2(null, 0);
-      std::vector<char*> cargv;
-      for (std::string& a : argv) cargv.push_back(a.data());
-      cargv.push_back(nullptr);
-      execv(cargv[0], cargv.data());
-      _exit(127);
-    }
-  }
-  ~Job() {
-    if (pid_ > 0 && !reaped_) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-  }
-  pid_t pid() const { return pid_; }
-
-  // Waits up to `seconds`; false on timeout (the launcher is then killed).
-  bool wait(double seconds) {
-    auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
-    for (;;) {
-      int st = 0;
-      if (waitpid(pid_, &st, WNOHANG) == pid_) {
-        reaped_ = true;
-        status_ = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-        return true;
-      }
-      if (Clock::now() > deadline) {
-        kill(pid_, SIGKILL);
-        waitpid(pid_, nullptr, 0);
-        reaped_ = true;
-        return false;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
-  }
-  bool waitForStderr(const std::string& text, double seconds) {
-    auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
-    while (Clock::now() < deadline) {
-      if (err().find(text) != std::string::npos) return true;
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    return false;
-  }
-  int status() const { return status_; }
-  std::string err() const { return slurp(errPath_); }
-  std::string out() const { return slurp(outPath_); }
-
- private:
-  std::string outPath_, errPath_;
-  pid_t pid_ = -1;
-  bool reaped_ = false;
-  int status_ = -1;
-};
+ChildProcess startJob(int ranks, const std::vector<std::string>& args, const std::string& dir) {
+  prepareEnvironment();
+  std::vector<std::string> launcher;
+  if (ranks > 0) launcher = {mpiexec(), "--allow-run-as-root", "--oversubscribe", "-np", std::to_string(ranks)};
+  return ChildProcess(lc::testing::lightcutsCommand(args, launcher), dir);
+}
 
 // The process of rank `rank` among the launcher's descendants (by OMPI_COMM_WORLD_RANK in
 // its environment), or -1.
@@ -176,15 +108,6 @@ pid_t rankProcess(pid_t launcher, int rank) {
   return -1;
 }
 
-std::set<std::string> filesIn(const std::string& dir) {
-  std::set<std::string> s;
-  for (const auto& e : fs::directory_iterator(dir)) {
-    std::string n = e.path().filename().string();
-    if (n != ".stdout" && n != ".stderr") s.insert(n);
-  }
-  return s;
-}
-
 struct Variant {
   std::string name;
   std::vector<std::string> args;
@@ -203,9 +126,9 @@ void expectSameImages(const Variant& v) {
     std::vector<std::string> args{"render", "scene.ray", "-o", "img.exr", "--stats", "stats.json",
                                   "--cut-heatmap", "cut.png", "--threads", "1"};
     args.insert(args.end(), v.args.begin(), v.args.end());
-    Job job(ranks, args, sub(ranks));
+    ChildProcess job = startJob(ranks, args, sub(ranks));
     EXPECT_TRUE(job.wait(600)) << v.name << ", " << ranks << " ranks: timed out";
-    EXPECT_EQ(job.status(), 0) << v.name << ", " << ranks << " ranks:\n" << job.err();
+    EXPECT_EQ(job.shellStatus(), 0) << v.name << ", " << ranks << " ranks:\n" << job.stderrText();
     return nlohmann::json::parse(slurp(sub(ranks) + "/stats.json"), nullptr, false);
   };
   nlohmann::json one = renderWith(0);
@@ -276,11 +199,11 @@ TEST(Distributed, AnErrorIsReportedOnceAndFailsTheJob) {
   SKIP_WITHOUT_MPI();
   TempDir dir;
   std::ofstream(dir.file("bad.ray")) << "SBT-raytracer 1.0\ncamera { position = (0,0,10)\n";
-  Job job(2, {"render", "bad.ray", "-o", "out.png"}, dir.path());
+  ChildProcess job = startJob(2, {"render", "bad.ray", "-o", "out.png"}, dir.path());
   ASSERT_TRUE(job.wait(60));
-  EXPECT_EQ(job.status(), 1) << job.err();
+  EXPECT_EQ(job.shellStatus(), 1) << job.stderrText();
   const std::string msg = "lightcuts: bad.ray:3:1: error: expected '}' to close camera opened at 2:8, got end of file";
-  std::string err = job.err();
+  std::string err = job.stderrText();
   size_t first = err.find(msg);
   ASSERT_NE(first, std::string::npos) << err;
   EXPECT_EQ(err.find(msg, first + 1), std::string::npos) << "reported more than once:\n" << err;
@@ -309,9 +232,9 @@ TEST(Distributed, KilledRankFailsTheJobAndKeepsTheOldOutput) {
   std::ofstream(dir.file("slow.ray")) << slowScene();
   const std::string old = "previous image: must survive the failed job byte for byte";
   std::ofstream(dir.file("out.png")) << old;
-  Job job(2, kSlowRender, dir.path());
+  ChildProcess job = startJob(2, kSlowRender, dir.path());
   // Rank 0's progress line appears once rendering has run for a second.
-  ASSERT_TRUE(job.waitForStderr("rendering", 120)) << job.err();
+  ASSERT_TRUE(job.waitForStderr("rendering", 120)) << job.stderrText();
   pid_t victim = rankProcess(job.pid(), 1);
   ASSERT_GT(victim, 0) << "no rank 1 among mpirun's processes";
   auto t0 = Clock::now();
@@ -319,12 +242,12 @@ TEST(Distributed, KilledRankFailsTheJobAndKeepsTheOldOutput) {
   ASSERT_TRUE(job.wait(30)) << "the job did not end after a rank was killed";
   double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   RecordProperty("seconds_to_fail", std::to_string(seconds));
-  std::printf("job failed %.2f s after rank 1 was killed (exit %d)\n", seconds, job.status());
-  EXPECT_NE(job.status(), 0) << job.err();
+  std::printf("job failed %.2f s after rank 1 was killed (exit %d)\n", seconds, job.shellStatus());
+  EXPECT_NE(job.shellStatus(), 0) << job.stderrText();
   EXPECT_LT(seconds, 10.0);
   EXPECT_EQ(slurp(dir.file("out.png")), old);
   // The launcher names the rank that died.
-  EXPECT_NE(job.err().find("signal 9"), std::string::npos) << job.err();
+  EXPECT_NE(job.stderrText().find("signal 9"), std::string::npos) << job.stderrText();
   // Nothing but (perhaps) the partial image is left beside the old output.
   std::set<std::string> files = filesIn(dir.path());
   files.erase("out.png.partial.exr");
@@ -337,20 +260,20 @@ TEST(Distributed, SigintToMpirunKeepsTheOldOutputAndWritesThePartialImage) {
   std::ofstream(dir.file("slow.ray")) << slowScene();
   const std::string old = "previous image: must survive the interruption byte for byte";
   std::ofstream(dir.file("out.png")) << old;
-  Job job(2, kSlowRender, dir.path());
-  ASSERT_TRUE(job.waitForStderr("rendering", 120)) << job.err();
+  ChildProcess job = startJob(2, kSlowRender, dir.path());
+  ASSERT_TRUE(job.waitForStderr("rendering", 120)) << job.stderrText();
   auto t0 = Clock::now();
   kill(job.pid(), SIGINT);
   ASSERT_TRUE(job.wait(30));
   double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-  std::printf("job stopped %.2f s after SIGINT (exit %d)\n", seconds, job.status());
+  std::printf("job stopped %.2f s after SIGINT (exit %d)\n", seconds, job.shellStatus());
   // mpirun passes the interrupt on as SIGTERM (after SIGCONT, about a second later) and
   // exits with its own status for an aborted job.
-  EXPECT_NE(job.status(), 0);
+  EXPECT_NE(job.shellStatus(), 0);
   EXPECT_LT(seconds, 10.0);
   EXPECT_EQ(slurp(dir.file("out.png")), old);
-  EXPECT_NE(job.err().find("interrupted; out.png untouched, partial image in out.png.partial.exr"), std::string::npos)
-      << job.err();
+  EXPECT_NE(job.stderrText().find("interrupted; out.png untouched, partial image in out.png.partial.exr"), std::string::npos)
+      << job.stderrText();
   EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"slow.ray", "out.png", "out.png.partial.exr"}));
   EXPECT_GT(fs::file_size(dir.file("out.png.partial.exr")), 1000u);
 }

@@ -151,6 +151,29 @@ TEST(FuzzRegression, KnownBadImagesAreRefusedClearly) {
   EXPECT_EQ(refused, reasons.size());
 }
 
+// compare's inputs: each file is one image, compared with itself. pnm_header_without_maxval.pgm
+// ("P58015 1", then a non-digit) was read by stb_image as an 8015x1 image of uninitialised
+// memory (the maxval missing, read as 0): it compared unequal to itself.
+TEST(FuzzRegression, CompareInputsAreRefusedClearly) {
+  const std::map<std::string, std::string> reasons = {
+      {"pnm_header_without_maxval.pgm", "bad PNM header (expected the width, height and maxval as decimal numbers)"},
+  };
+  size_t refused = 0;
+  for (const std::string& f : inputsOf("compare")) {
+    SCOPED_TRACE(f);
+    const std::string name = fs::path(f).filename().string();
+    ASSERT_EQ(reasons.count(name), 1u) << "add the expected message of " << name;
+    try {
+      lc::io::readImage(f);
+      ADD_FAILURE() << "read";
+    } catch (const lc::Error& e) {
+      EXPECT_EQ(std::string(e.what()), "cannot read image '" + f + "': " + reasons.at(name));
+      ++refused;
+    }
+  }
+  EXPECT_EQ(refused, reasons.size());
+}
+
 TEST(FuzzRegression, RefusedFormatsSayWhy) {
   lc::testing::TempDir dir;
   std::ofstream(dir.file("x.gif"), std::ios::binary) << "GIF89a\x01\x00\x01\x00\x00\x00\x00;";

@@ -534,7 +534,11 @@ bool hdrDecodeTerminates(const std::vector<uint8_t>& b) {
 // buffer half the size it should be (a heap overflow when read: found by the image fuzz
 // target, data/regressions/image/pnm16_channel_conversion.pgm), and it does not swap the
 // big-endian samples. They are decoded here instead: value / maxval. Returns false (and
-// leaves the file to stb) when the header is not a 16-bit binary PNM header.
+// leaves the file to stb) when the header is an 8-bit one whose samples are all there.
+// stb_image's header parsing is lax: a missing number reads as 0 and the character after
+// the maxval is skipped whatever it is, so "P5 8015 1" followed by a non-digit decoded as
+// an 8015x1 image of uninitialised memory (compare fuzz target). A header that is not three
+// decimal numbers with the maxval followed by one whitespace character is refused here.
 bool readPnm16(const std::string& path, const std::vector<uint8_t>& b, bool srgb, uint64_t maxPixels,
                Image& out) {
   size_t p = 2;
@@ -560,11 +564,14 @@ bool readPnm16(const std::string& path, const std::vector<uint8_t>& b, bool srgb
     return true;
   };
   uint64_t w = 0, h = 0, maxval = 0;
-  if (!number(w) || !number(h) || !number(maxval)) return false;
+  if (!number(w) || !number(h) || !number(maxval))
+    throwDecode(path, "bad PNM header (expected the width, height and maxval as decimal numbers)");
+  if (p >= b.size() || !isSpace(b[p]))
+    throwDecode(path, "bad PNM header (expected one whitespace character after the maxval)");
   if (maxval <= 255) {
     // 8-bit: stb decodes those, but reads missing samples as whatever its buffer held
     // (issue 23: a 32x32 P6 header and 100 bytes compared equal to anything dark).
-    if (p < b.size() && isSpace(b[p]) && w > 0 && h > 0 && w <= uint64_t(1) << 24 && h <= uint64_t(1) << 24) {
+    if (w > 0 && h > 0 && w <= uint64_t(1) << 24 && h <= uint64_t(1) << 24) {
       const uint64_t need = w * h * (b[1] == '5' ? 1 : 3);
       if (b.size() - (p + 1) < need)
         throwDecode(path, "truncated PNM data: " + std::to_string(b.size() - (p + 1)) + " bytes of samples, the header needs " +
@@ -572,7 +579,6 @@ bool readPnm16(const std::string& path, const std::vector<uint8_t>& b, bool srgb
     }
     return false;
   }
-  if (p >= b.size() || !isSpace(b[p])) throwDecode(path, "bad PNM header");
   ++p;  // exactly one whitespace character before the samples
   if (maxval > 65535) throwDecode(path, "PNM maxval " + std::to_string(maxval) + " is more than 65535");
   if (w == 0 || h == 0) throwDecode(path, "empty image");

@@ -458,6 +458,35 @@ TEST(ImageTruncated, PpmAndPgm) {
   EXPECT_EQ(readImage(dir.file("ok.ppm")).width, 32);
 }
 
+// stb_image's PNM header parsing is lax: a missing number reads as 0 and the character after
+// the maxval is skipped whatever it is. "P58015 1" then a non-digit (found by the compare
+// fuzz target, data/regressions/compare/pnm_header_without_maxval.pgm) decoded as an 8015x1
+// image of uninitialised memory, which compared unequal to itself. Such headers are refused.
+TEST(ImageTruncated, PnmHeadersStbWouldMisread) {
+  TempDir dir;
+  const std::string numbers = "bad PNM header (expected the width, height and maxval as decimal numbers)";
+  const std::string space = "bad PNM header (expected one whitespace character after the maxval)";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {std::string("P58015 1\xa9" "7"), numbers},        // the fuzzer's input: no maxval
+      {"P6 2 2\n", numbers},                             // no maxval, end of file
+      {"P5 2x2 255\n" + std::string(4, 'a'), numbers},   // no height
+      {"P5\n", numbers},                                 // no numbers at all
+      {"P5 2 2 255", space},                             // nothing after the maxval
+      {"P5 2 2 255x" + std::string(4, 'a'), space},       // not whitespace after the maxval
+      {"P5 1 1 65535x" + std::string(2, 'a'), space},     // 16-bit (was "bad PNM header")
+  };
+  for (size_t i = 0; i < cases.size(); ++i) {
+    const std::string f = dir.file("h" + std::to_string(i) + ".pgm");
+    writeRaw(f, std::vector<uint8_t>(cases[i].first.begin(), cases[i].first.end()));
+    EXPECT_EQ(readError(f), "cannot read image '" + f + "': " + cases[i].second) << cases[i].first;
+  }
+  // Well-formed headers still read, comments included.
+  writeRaw(dir.file("c.pgm"), bytesOf("P5\n# a comment\n2 1\n255\n", 2));
+  EXPECT_EQ(readError(dir.file("c.pgm")), "");
+  writeRaw(dir.file("t.ppm"), bytesOf("P6\t2\r1 255\r", 6));
+  EXPECT_EQ(readError(dir.file("t.ppm")), "");
+}
+
 TEST(ImageTruncated, Bmp) {
   TempDir dir;
   std::vector<uint8_t> rgb(size_t(8 * 8 * 3), 200);
