@@ -39,6 +39,20 @@ constexpr int kDefaultWidth = 512;      // when neither --width nor --height is 
 constexpr float kLightcutsDefaultError = lightcuts::CutOptions{}.errorRatio;
 constexpr float kCourseDefaultError = lightcuts::kCourseCutsDefaultError;
 
+// The share of a 32 x 32 grid of camera rays through the image that hit any surface.
+double cameraHitFraction(const scene::Scene& scene) {
+  constexpr int kGrid = 32;
+  const scene::Camera& cam = scene.camera();
+  int hits = 0;
+  for (int y = 0; y < kGrid; ++y)
+    for (int x = 0; x < kGrid; ++x) {
+      scene::Ray ray{cam.eye, normalize(cam.direction((float(x) + 0.5f) / kGrid, (float(y) + 0.5f) / kGrid)), 0, kInf};
+      scene::Hit h;
+      hits += scene.intersect(ray, h);
+    }
+  return double(hits) / (kGrid * kGrid);
+}
+
 // --reconstruct auto: reconstruction cuts (every 4 pixels) from 512 x 512 pixels up, a
 // full lightcut at every point below. A cell of 4 x 4 pixels covers four times the
 // surface at 256 x 256 that it does at 512 x 512, and shadows thinner than a cell are what
@@ -433,6 +447,7 @@ void reportRender(const RenderArgs& a, Cluster* cluster, const RenderSetup& s, c
     // Judged as displayed: the 8-bit output's tone map, or sRGB for an EXR viewed as usual.
     const auto& es = rr.stats.eval;
     RenderFacts facts{scene.lights().size(), rr.stats.primaryRays, es.shadingPoints, es.shadowRays, es.occludedRays};
+    facts.cameraHitFraction = cameraHitFraction(scene);
     std::string w = blackImageWarning(rr.image, s.ext == "exr" ? io::ToneMap::Srgb : a.tonemap, a.exposure, facts);
     if (!w.empty()) printWarning(w);
   }

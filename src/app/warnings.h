@@ -20,6 +20,9 @@ struct RenderFacts {
   uint64_t shadingPoints = 0;   // hits that were shaded (primary and secondary)
   uint64_t shadowRays = 0;
   uint64_t occludedRays = 0;    // shadow rays that found their light hidden (a lower bound)
+  // The share of a grid of camera rays that hit any surface, black or not (-1: unknown):
+  // few shading points with many hits means the surfaces' materials are black.
+  double cameraHitFraction = -1;
 };
 
 // The fraction of pixels counted as black: those whose every channel is at most

@@ -33,6 +33,14 @@ TEST(BlackImage, ReasonFollowsTheFacts) {
   empty.shadingPoints = 1;
   EXPECT_NE(blackImageWarning(black, io::ToneMap::Srgb, 0, empty).find("the camera sees almost nothing"),
             std::string::npos);
+  // Many camera rays hit something, and almost nothing was shaded: black materials.
+  RenderFacts blackSurfaces = empty;
+  blackSurfaces.cameraHitFraction = 0.4;
+  EXPECT_NE(blackImageWarning(black, io::ToneMap::Srgb, 0, blackSurfaces).find("have black materials"),
+            std::string::npos);
+  blackSurfaces.cameraHitFraction = 0.01;
+  EXPECT_NE(blackImageWarning(black, io::ToneMap::Srgb, 0, blackSurfaces).find("the camera sees almost nothing"),
+            std::string::npos);
   RenderFacts shadow = f;
   shadow.occludedRays = 300;
   EXPECT_NE(blackImageWarning(black, io::ToneMap::Srgb, 0, shadow).find("everything is in shadow (75%"),
