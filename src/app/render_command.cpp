@@ -159,6 +159,9 @@ std::string defaultOutput(const std::string& scene) {
 
 int renderJob(RenderArgs& a, Cluster* cluster);
 
+// How long a rank other than 0 waits, after an error, for rank 0 to end the job.
+constexpr int kNonRootErrorDelaySeconds = 10;
+
 int runRender(RenderArgs& a) {
   // Under an MPI launcher (mpirun, srun) every process runs this; see app/distributed.h.
   std::unique_ptr<Cluster> cluster = joinCluster();
@@ -170,9 +173,11 @@ int runRender(RenderArgs& a) {
       status = renderJob(a, cluster.get());
     } catch (const Error& e) {
       // Every rank reads the same input, so rank 0 most likely fails the same way: give it
-      // a moment to say so and end the job (which ends this rank too), rather than print
-      // the message once per rank.
-      std::this_thread::sleep_for(std::chrono::seconds(2));
+      // time to say so and end the job (which ends this rank too), rather than print the
+      // message once per rank. Two seconds were not always enough under the sanitizers on
+      // a loaded machine (rank 1's message came too, 1 run in ~50); the wait only delays
+      // the rare error that rank 0 does not share (a file missing on one node).
+      std::this_thread::sleep_for(std::chrono::seconds(kNonRootErrorDelaySeconds));
       throw Error(fmt::format("rank {} on {}: {}", cluster->rank(), cluster->host(), e.what()));
     }
   }
