@@ -175,10 +175,10 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
   // The representatives' lights are scattered over the light array: a cache miss each when
   // read as the walk meets them, so they are fetched a few nodes ahead here.
   constexpr size_t kAhead = 8;
-  const size_t count_ = out.nodes.size();
-  for (size_t i = 0; i < std::min(kAhead, count_); ++i) __builtin_prefetch(&lights.lights[out.nodes[i].rep]);
-  for (size_t i = 0; i < count_; ++i) {
-    if (i + kAhead < count_) __builtin_prefetch(&lights.lights[out.nodes[i + kAhead].rep]);
+  const size_t nodeCount = out.nodes.size();
+  for (size_t i = 0; i < std::min(kAhead, nodeCount); ++i) __builtin_prefetch(&lights.lights[out.nodes[i].rep]);
+  for (size_t i = 0; i < nodeCount; ++i) {
+    if (i + kAhead < nodeCount) __builtin_prefetch(&lights.lights[out.nodes[i + kAhead].rep]);
     MergedCut::Node& node = out.nodes[i];
     const Light& rep = lights.lights[node.rep];
     node.group = rep.group;
