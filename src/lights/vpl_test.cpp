@@ -1,22 +1,14 @@
 #include "lights/vpl.h"
 
-#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "io/ray_parser.h"
+#include "test_scenes.h"
 
 namespace lc::lights {
 namespace {
 
-// A closed box of albedo `a`, 20 units wide (every wall farther than 1 from the light, so
-// min(1, 1/d^2) is exactly 1/d^2), with one point light of intensity I at its centre.
-std::unique_ptr<scene::Scene> closedBox(float a, float I) {
-  std::string text = fmt::format(R"(SBT-raytracer 1.0
-point_light {{ position = (0.3, -0.2, 0.1); colour = ({}, {}, {}); }}
-scale(20, box {{ material = {{ diffuse = ({}, {}, {}); }}; }})
-)", I, I, I, a, a, a);
-  return scene::Scene::build(io::parseRayString(text, "box.ray", ""));
-}
+using lc::testing::closedBox;  // albedo a, 20 units wide, one point light of intensity I
 
 TEST(Vpl, OneBounceCarriesAlbedoTimesEmittedPower) {
   auto s = closedBox(0.5f, 2.0f);

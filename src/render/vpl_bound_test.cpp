@@ -1,25 +1,16 @@
 // VPLs (lights/) seen by the Lightcuts bounds (lightcuts/): here in render, the first layer
 // that sees both, so that lights/ includes nothing of lightcuts/.
-#include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "io/ray_parser.h"
 #include "lightcuts/bounds.h"
 #include "lightcuts/light_tree.h"
 #include "lights/vpl.h"
+#include "test_scenes.h"
 
 namespace lc {
 namespace {
 
-// lights/vpl_test.cpp's closed box: albedo `a`, 20 units wide, one point light of
-// intensity I inside.
-std::unique_ptr<scene::Scene> closedBox(float a, float I) {
-  std::string text = fmt::format(R"(SBT-raytracer 1.0
-point_light {{ position = (0.3, -0.2, 0.1); colour = ({}, {}, {}); }}
-scale(20, box {{ material = {{ diffuse = ({}, {}, {}); }}; }})
-)", I, I, I, a, a, a);
-  return scene::Scene::build(io::parseRayString(text, "box.ray", ""));
-}
+using lc::testing::closedBox;  // albedo a, 20 units wide, one point light of intensity I
 
 // The VPL clamp is the attenuation of every method (lights/vpl_test.cpp checks the
 // group's): the Lightcuts bound of a one-VPL cluster uses it too, so it is >= the exact
