@@ -131,12 +131,19 @@ MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, uint32_t top,
       continue;
     }
     if (n.isLeaf()) {
-      const NodeMoments leaf = tree.momentsOf(lights, i);
+      // From the leaf's node, not its light: leaves come in tree order and their lights in
+      // scene order, a cache miss each (0.4 of 1.1 s at 8.1M lights). The node holds the
+      // light's position (directional: the direction toward it, minus its travel direction)
+      // and, for oriented and spot lights, its axis. (An omni light's node has no axis: its
+      // light is read, to keep the moments momentsOf() defines, though nothing reads an omni
+      // tree's mean axis.)
       MomentSums s;
       s.w = lum(n.intensity);
       s.n = 1;
-      s.posU = Vec3d(leaf.centroid);
-      s.axisU = Vec3d(leaf.meanAxis);
+      s.posU = Vec3d(n.lo);
+      s.axisU = tree.type == LightType::Directional ? Vec3d(-n.lo)
+                : tree.type == LightType::Omni      ? Vec3d(lights.lights[n.rep].direction)
+                                                    : Vec3d(n.axis);
       s.pos = s.posU * s.w;
       s.axis = s.axisU * s.w;
       done.push_back(s);
