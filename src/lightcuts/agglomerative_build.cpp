@@ -589,8 +589,9 @@ class ApproximateClustering {
   // (a.weight + x.weight) * (|union box diagonal|^2 + c^2 (1 - cos union half-angle)^2)
   // from one cluster to all of them, with the operations of the scalar form in its order
   // (min/max/clamp as std:: defines them, no FMA contraction): the trees are the same bit
-  // for bit as when it was computed pair by pair, at a third of the time. Both orders,
-  // a to x and x to a, as the cone union's rounding is not symmetric.
+  // for bit as when it was computed pair by pair (perf, 1M VPLs: 12.3% of the run's
+  // samples then, 9.7% now). Both orders, a to x and x to a, as the cone union's rounding
+  // is not symmetric.
   using V4 = float __attribute__((vector_size(16)));
   struct Columns {
     std::vector<float> f[11];  // lo xyz, hi xyz, axis xyz, halfAngle, weight

@@ -132,7 +132,7 @@ MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, uint32_t top,
     }
     if (n.isLeaf()) {
       // From the leaf's node, not its light: leaves come in tree order and their lights in
-      // scene order, a cache miss each (0.4 of 1.1 s at 8.1M lights). The node holds the
+      // scene order, a cache miss each (half of this pass at 8.1M lights). The node holds the
       // light's position (directional: the direction toward it, minus its travel direction)
       // and, for oriented and spot lights, its axis. (An omni light's node has no axis: its
       // light is read, to keep the moments momentsOf() defines, though nothing reads an omni
