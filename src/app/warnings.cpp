@@ -28,15 +28,16 @@ std::string blackImageWarning(const io::Image& image, io::ToneMap tonemap, float
   if (f.lights == 0)
     return what + ": the scene has no lights";
   double hit = f.primaryRays ? double(f.shadingPoints) / double(f.primaryRays) : 1;
-  if ((f.shadingPoints == 0 || hit < 0.02) && f.cameraHitFraction >= 0.02)
-    return what + fmt::format(": the surfaces the camera sees have black materials ({} shading points from {} camera "
-                              "rays, though {:.0f}% of them hit a surface): a material's colours are 0 unless set; "
-                              "give the objects one, e.g. material = {{ diffuse = (0.8, 0.8, 0.8); }}",
-                              f.shadingPoints, f.primaryRays, 100 * f.cameraHitFraction);
-  if (f.shadingPoints == 0 || hit < 0.02)
+  if (f.shadingPoints == 0 || hit < 0.02) {
+    if (f.cameraHitFraction >= 0.02)
+      return what + fmt::format(": the surfaces the camera sees have black materials ({} shading points from {} camera "
+                                "rays, though {:.0f}% of them hit a surface): a material's colours are 0 unless set; "
+                                "give the objects one, e.g. material = {{ diffuse = (0.8, 0.8, 0.8); }}",
+                                f.shadingPoints, f.primaryRays, 100 * f.cameraHitFraction);
     return what + fmt::format(": the camera sees almost nothing ({} shading points from {} camera rays); check the "
                               "camera's position and viewdir",
                               f.shadingPoints, f.primaryRays);
+  }
   double blocked = f.shadowRays ? double(f.occludedRays) / double(f.shadowRays) : 0;
   if (blocked >= 0.5)
     return what + fmt::format(": everything is in shadow ({:.0f}% of the shadow rays found their light blocked); a "
