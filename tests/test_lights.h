@@ -40,11 +40,15 @@ inline ShadingPoint point(Vec3 p) {
   return sp;
 }
 
-// Lights under node i.
-inline uint32_t leafCount(const LightTree& t, uint32_t i) {
-  const LightNode& n = t.nodes[i];
-  return n.isLeaf() ? 1u : leafCount(t, n.left) + leafCount(t, n.left + 1);
+// Lights under node r, counted leaf by leaf.
+inline uint32_t leafCount(const LightTree& t, NodeRef r) {
+  if (isLeafRef(r)) return 1;
+  const LightNode& n = t.nodes[r];
+  return leafCount(t, n.left(r)) + leafCount(t, n.right(r));
 }
+// The root's two children.
+inline NodeRef rootLeft(const LightTree& t) { return t.nodes[t.root].left(t.root); }
+inline NodeRef rootRight(const LightTree& t) { return t.nodes[t.root].right(t.root); }
 
 // ---- random clusters for the property tests (bounds, estimates) ----
 
@@ -121,7 +125,6 @@ inline Config randomConfig(Rng& r, LightType type) {
   bool withCone = type == LightType::Oriented || type == LightType::Spot;
   for (int i = 1; i < n; ++i) acc = detail::mergeClusters(acc, cl[size_t(i)], 0, i, withCone, 7);
   detail::setNodeFromCluster(c.node, acc);
-  c.node.left = 1;  // an inner node, as a cluster of several lights is in a tree
 
   ShadingPoint& sp = c.sp;
   sp.p = r.below(5) == 0 ? centre : Vec3(6 * r.uniform() - 3, 6 * r.uniform() - 3, 6 * r.uniform() - 3);

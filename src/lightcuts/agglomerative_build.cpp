@@ -412,14 +412,13 @@ class AgglomerativeBuilder {
 };
 
 
-// The layout of detail::layoutTree and the preorder of computePreorder in one pass over the
-// clusters, the subtrees below the top levels in parallel. Node numbers and preorder
-// positions follow from the clusters' light counts: the node taken at preorder position p
-// with k inner nodes before it in preorder puts its children at 1 + 2k; a left child
-// follows its parent in preorder, a right one the left subtree's 2 count - 1 nodes.
+// The layout of detail::layoutTree, the subtrees below the top levels in parallel. Slots
+// follow from the clusters' light counts: a left child's slot is its parent's + 1, a right
+// one's its parent's + the left subtree's light count. Leaves are only named (by their
+// light) in their parent, so their lights are never read here.
 struct LayoutItem {
-  int32_t cluster;
-  uint32_t node, innerBefore, pre;
+  int32_t cluster;  // an inner cluster
+  uint32_t slot;
 };
 
 class TreeWriter {
@@ -427,13 +426,17 @@ class TreeWriter {
   TreeWriter(const ClusterStore& clusters, LightTree& tree) : cl_(clusters), tree_(tree) {}
 
   void run(int32_t root) {
-    size_t total = 2 * cl_.leaves() - 1;
-    tree_.nodes.resize(total);
-    tree_.preorder.resize(total);
+    tree_.lightTotal = uint32_t(cl_.leaves());
+    if (size_t(root) < cl_.leaves()) {
+      tree_.root = leafRef(cl_.indices[size_t(root)]);
+      return;
+    }
+    tree_.root = 0;
+    tree_.nodes.resize(cl_.leaves() - 1);  // unwritten: every node is written below
     // Top levels serially, down to subtrees of at most kTask lights; those in parallel.
     constexpr uint32_t kTask = 1u << 14;
     std::vector<LayoutItem> tasks;
-    std::vector<LayoutItem> stack{{root, 0, 0, 0}};
+    std::vector<LayoutItem> stack{{root, 0}};
     while (!stack.empty()) {
       LayoutItem it = stack.back();
       stack.pop_back();
@@ -444,42 +447,27 @@ class TreeWriter {
       write(it, stack);
     }
     tbb::parallel_for(size_t(0), tasks.size(), [&](size_t k) {
-      // Leaves are written in batches, their lights prefetched first (see prefetch()).
-      std::vector<LayoutItem> st{tasks[k]}, leaves;
-      std::vector<int32_t> ids;
-      auto flush = [&] {
-        cl_.prefetch(ids.data(), ids.size());
-        for (const LayoutItem& it : leaves) write(it, st);
-        leaves.clear();
-        ids.clear();
-      };
+      std::vector<LayoutItem> st{tasks[k]};
       while (!st.empty()) {
         LayoutItem it = st.back();
         st.pop_back();
-        if (size_t(it.cluster) < cl_.leaves()) {
-          leaves.push_back(it);
-          ids.push_back(it.cluster);
-          if (leaves.size() == 64) flush();
-          continue;
-        }
         write(it, st);
       }
-      flush();
     });
   }
 
  private:
-  // Writes one node; pushes its children (left on top).
+  // Writes one inner node; pushes its inner children (left on top).
   void write(const LayoutItem& it, std::vector<LayoutItem>& stack) {
-    Cluster c = cl_.get(it.cluster);
-    LightNode& n = tree_.nodes[it.node];
+    const Cluster& c = cl_.merged[size_t(it.cluster) - cl_.leaves()];
+    LightNode& n = tree_.nodes[it.slot];
     detail::setNodeFromCluster(n, c);
-    tree_.preorder[it.node] = it.pre;
-    if (c.left < 0) return;
-    n.left = 2 * it.innerBefore + 1;
-    uint32_t leftCount = cl_.count(c.left);
-    stack.push_back(LayoutItem{c.right, n.left + 1, it.innerBefore + leftCount, it.pre + 2 * leftCount});
-    stack.push_back(LayoutItem{c.left, n.left, it.innerBefore + 1, it.pre + 1});
+    const bool leftLeaf = size_t(c.left) < cl_.leaves(), rightLeaf = size_t(c.right) < cl_.leaves();
+    const uint32_t leftCount = cl_.count(c.left);
+    n.setChildren(leftLeaf, leftLeaf ? cl_.indices[size_t(c.left)] : leftCount, rightLeaf,
+                  rightLeaf ? cl_.indices[size_t(c.right)] : 0, c.count);
+    if (!rightLeaf) stack.push_back(LayoutItem{c.right, it.slot + leftCount});
+    if (!leftLeaf) stack.push_back(LayoutItem{c.left, it.slot + 1});
   }
 
   const ClusterStore& cl_;

@@ -209,14 +209,15 @@ TEST(DirectionalTreeBounds, EveryNodeOfAnEnvironmentTreeBracketsItsLights) {
   std::vector<uint32_t> idx(set.lights.size());
   for (uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
   LightTree tree = buildAgglomerativeTree(set, idx, LightType::Directional, 0, 1);
-  ASSERT_EQ(tree.nodes.size(), 2 * idx.size() - 1);
+  ASSERT_EQ(tree.nodes.size(), idx.size() - 1);
   // The same tree with the cones of directions buildLightForest gives directional trees:
   // both must bracket every node's sum.
   LightTree coned = tree;
   computeDirectionCones(set, coned);
   const LightTree* trees[2] = {&tree, &coned};
   double spread[2] = {0, 0};
-  std::vector<Color> sum(tree.nodes.size());
+  const std::vector<NodeRef> all = tree.preorderNodes();
+  std::vector<Color> sum(tree.nodes.size());  // per inner node
   int lit = 0;
   for (int k = 0; k < 300; ++k) {
     ShadingPoint sp;
@@ -230,28 +231,28 @@ TEST(DirectionalTreeBounds, EveryNodeOfAnEnvironmentTreeBracketsItsLights) {
     const float shininess[] = {0, 1, 10, 64, 128};
     sp.shininess = shininess[r.below(5)];
     BoundFrames fr(sp);
-    // Children follow parents: sum bottom-up.
-    for (size_t i = tree.nodes.size(); i-- > 0;) {
-      const LightNode& n = tree.nodes[i];
-      if (n.isLeaf()) {
-        const Light& l = set.lights[n.rep];
-        Color mg;
-        Vec3 wi;
-        float d;
-        sum[i] = lightContribution(l, g, sp, mg, wi, d) ? mg * l.intensity : Color(0);
-      } else {
-        sum[i] = sum[n.left] + sum[n.left + 1];
-      }
-    }
+    // A node's sum: a leaf's light, an inner node's children (slots after their parent's:
+    // summed bottom-up).
+    auto sumOf = [&](NodeRef r) {
+      if (!isLeafRef(r)) return sum[r];
+      const Light& l = set.lights[leafLight(r)];
+      Color mg;
+      Vec3 wi;
+      float d;
+      return lightContribution(l, g, sp, mg, wi, d) ? mg * l.intensity : Color(0);
+    };
+    for (size_t i = tree.nodes.size(); i-- > 0;)
+      sum[i] = sumOf(tree.nodes[i].left(NodeRef(i))) + sumOf(tree.nodes[i].right(NodeRef(i)));
     for (int c = 0; c < 2; ++c)
-      for (size_t i = 0; i < tree.nodes.size(); ++i) {
+      for (NodeRef i : all) {
         Color lower;
-        Color upper = clusterBounds(trees[c]->nodes[i], LightType::Directional, g, sp, fr, &lower);
+        Color upper = clusterBounds(trees[c]->node(set, i), LightType::Directional, g, sp, fr, &lower);
+        const Color want = sumOf(i);
         for (int ch = 0; ch < 3; ++ch) {
-          ASSERT_GE(upper[ch] * (1 + 1e-5f) + 1e-12f, sum[i][ch]) << "point " << k << " node " << i << " cones " << c;
-          ASSERT_LE(lower[ch], sum[i][ch] * (1 + 1e-5f) + 1e-12f) << "point " << k << " node " << i << " cones " << c;
+          ASSERT_GE(upper[ch] * (1 + 1e-5f) + 1e-12f, want[ch]) << "point " << k << " node " << i << " cones " << c;
+          ASSERT_LE(lower[ch], want[ch] * (1 + 1e-5f) + 1e-12f) << "point " << k << " node " << i << " cones " << c;
         }
-        if (!tree.nodes[i].isLeaf() && tree.nodes[i].lights <= 256) spread[c] += luminance(upper - lower);
+        if (!isLeafRef(i) && tree.nodes[i].lights() <= 256) spread[c] += luminance(upper - lower);
       }
     lit += luminance(sum[0]) > 0;
   }

@@ -1,5 +1,5 @@
 // Internal to the tree builders: clusters as they are formed, merged and finally laid out
-// as LightNodes (children adjacent, parents before children).
+// as a LightTree (inner nodes in preorder, leaves as their lights).
 #pragma once
 
 #include <algorithm>
@@ -77,45 +77,45 @@ inline Cluster mergeClusters(const Cluster& a, const Cluster& b, int32_t ia, int
   return c;
 }
 
-// A node's box, cone, intensity and representative from its cluster; no children (left = 0).
+// A node's box, cone, intensity and representative from its cluster; children unset.
 inline void setNodeFromCluster(LightNode& n, const Cluster& c) {
   n.lo = c.lo;
   n.hi = c.hi;
   n.axis = c.axis;
   n.cosHalfAngle = c.cosHalfAngle;
-  n.lights = c.count;
   // Clamped: lights of huge power (sums beyond FLT_MAX) keep finite node intensities.
   n.intensity = vmin(c.intensity.toFloat(), Color(std::numeric_limits<float>::max()));
   n.rep = c.rep;
-  n.left = 0;
 }
 
-// Lays the cluster tree under `root` out as LightNodes: root first, siblings adjacent.
-// `get(id)` returns cluster id (by value or reference); `count` bounds the node count.
+// Lays the cluster tree under `root` out as a LightTree: its inner nodes in preorder, its
+// leaves as their lights. `get(id)` returns cluster id (by value or reference).
 template <class Get>
-void layoutTree(const Get& get, size_t count, int32_t root, LightTree& tree) {
+void layoutTree(const Get& get, int32_t root, LightTree& tree) {
   tree.nodes.clear();
-  tree.nodes.reserve(count);
-  tree.nodes.push_back(LightNode{});
-  std::vector<std::pair<int32_t, uint32_t>> stack{{root, 0u}};
+  const Cluster top = get(root);
+  tree.lightTotal = top.count;
+  if (top.left < 0) {
+    tree.root = leafRef(top.rep);
+    return;
+  }
+  tree.root = 0;
+  tree.nodes.reserve(top.count - 1);
+  std::vector<int32_t> stack{root};
   while (!stack.empty()) {
-    auto [ci, ni] = stack.back();
+    const Cluster c = get(stack.back());
     stack.pop_back();
-    const Cluster& c = get(ci);
-    setNodeFromCluster(tree.nodes[ni], c);
-    if (c.left >= 0) {
-      uint32_t j = uint32_t(tree.nodes.size());
-      tree.nodes[ni].left = j;
-      tree.nodes.push_back(LightNode{});
-      tree.nodes.push_back(LightNode{});
-      stack.emplace_back(c.right, j + 1);
-      stack.emplace_back(c.left, j);
-    }
+    const Cluster l = get(c.left), r = get(c.right);
+    LightNode& n = tree.nodes.emplace_back();
+    setNodeFromCluster(n, c);
+    n.setChildren(l.left < 0, l.left < 0 ? l.rep : l.count, r.left < 0, r.rep, c.count);
+    if (r.left >= 0) stack.push_back(c.right);
+    if (l.left >= 0) stack.push_back(c.left);  // next: a left child's slot follows its parent's
   }
 }
 
 inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, LightTree& tree) {
-  layoutTree([&](int32_t id) -> const Cluster& { return clusters[size_t(id)]; }, clusters.size(), root, tree);
+  layoutTree([&](int32_t id) -> const Cluster& { return clusters[size_t(id)]; }, root, tree);
 }
 
 }  // namespace lc::lightcuts::detail

@@ -154,18 +154,18 @@ LightTree buildCourseTree(const LightSet& lights, const std::vector<uint32_t>& i
   int32_t root = sb.build(0, indices.size());
   detail::layoutTree(sb.clusters, root, tree);
   computeCourseData(lights, tree);
-  // Replace the bottom-up error bounds with the exact errors: walk clusters and nodes in
-  // the same order as the layout.
-  std::vector<std::pair<int32_t, uint32_t>> stack{{root, 0u}};
+  // Replace the bottom-up error bounds with the exact errors: the inner clusters in
+  // preorder, as the layout numbered their slots.
+  std::vector<int32_t> stack{root};
+  uint32_t slot = 0;
   while (!stack.empty()) {
-    auto [ci, ni] = stack.back();
+    const Cluster& c = sb.clusters[size_t(stack.back())];
+    const int32_t ci = stack.back();
     stack.pop_back();
-    tree.course[ni].error = sb.exactError[size_t(ci)];
-    const Cluster& c = sb.clusters[size_t(ci)];
-    if (c.left >= 0) {
-      stack.emplace_back(c.left, tree.nodes[ni].left);
-      stack.emplace_back(c.right, tree.nodes[ni].left + 1);
-    }
+    if (c.left < 0) continue;
+    tree.course[slot++].error = sb.exactError[size_t(ci)];
+    stack.push_back(c.right);
+    stack.push_back(c.left);
   }
   return tree;
 }

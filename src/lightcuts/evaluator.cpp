@@ -139,8 +139,10 @@ class Lightcuts final : public LightEvaluator {
     float lower, upper;   // luminance of the unshadowed bounds (first-order candidates)
     ShadowResult shadow;  // what the representative's shadow ray found
     // The node's children, representative and light count, copied from its LightNode so
-    // that refining it reads only its children's cache lines, not its own again.
-    uint32_t left, rep, lights;
+    // that refining it reads only its children's cache lines, not its own again, and its
+    // children's preorder positions (for the recorded cut).
+    NodeRef left, right;
+    uint32_t rep, lights, leftPre, rightPre;
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
     bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
   };
@@ -239,26 +241,33 @@ class Lightcuts final : public LightEvaluator {
     const bool firstOrder = opt_.estimator == Estimator::FirstOrder;
     const bool probes = opt_.visibilityProbes;
 
-    // Inner nodes pushed by the last refinement: their children's lights are prefetched
-    // after the next one (below).
-    std::pair<uint32_t, uint32_t> pending[2], fresh[2];
+    // Inner nodes pushed by the last refinement (tree, children): their children's lights
+    // are prefetched after the next one (below).
+    struct Pushed {
+      uint32_t tree;
+      NodeRef left, right;
+    };
+    Pushed pending[2], fresh[2];
     uint32_t pendingCount = 0, freshCount = 0;
     // Adds a node to the cut: its estimate to the total, and to the heap unless exact.
-    auto record1 = [&](uint32_t t, uint32_t ni, CutVisibility found, bool fo, float factor = 1) {
-      recorded.emplace_back(uint64_t(t) << 32 | CutRecord::pack(forest_.trees[t].preorder[ni], found, fo), factor);
+    auto record1 = [&](uint32_t t, uint32_t pre, CutVisibility found, bool fo, float factor = 1) {
+      recorded.emplace_back(uint64_t(t) << 32 | CutRecord::pack(pre, found, fo), factor);
     };
-    auto addNode = [&](uint32_t t, uint32_t ni, const Color& unit, const ShadowResult& shadow,
+    // Node ni, at preorder position pre.
+    auto addNode = [&](uint32_t t, NodeRef ni, uint32_t pre, const Color& unit, const ShadowResult& shadow,
                        bool boundary = false) {
       const CutVisibility found = shadow.found;
       const LightTree& tree = forest_.trees[t];
+      if (isLeafRef(ni)) {
+        total += unit * leafIntensity(lights_.lights[leafLight(ni)]);
+        ++cutSize;
+        if (record) record1(t, pre, found, false);
+        return;
+      }
       const LightNode& n = tree.nodes[ni];
       Color est = unit * n.intensity;
       total += est;
       ++cutSize;
-      if (n.isLeaf()) {
-        if (record) record1(t, ni, found, false);
-        return;
-      }
       ++stats.boundsEvaluated;
       // The total criterion adds up how far each estimate may be off: a cluster whose
       // representative is visible (and whose sibling's was: not on a shadow boundary,
@@ -273,10 +282,13 @@ class Lightcuts final : public LightEvaluator {
                                   tree.mixedGroups ? &tree.boundLow : nullptr);
       float b = luminance(upper);
       if (b > 0) {
-        // A node in the heap may be refined next: fetch its children while we work.
-        __builtin_prefetch(&tree.nodes[n.left]);
-        __builtin_prefetch(&tree.nodes[n.left + 1]);
-        if (freshCount < 2) fresh[freshCount++] = {t, n.left};
+        // A node in the heap may be refined next: fetch its children while we work (a
+        // leaf child: its light).
+        const NodeRef left = n.left(ni), right = n.right(ni);
+        for (NodeRef c : {left, right})
+          __builtin_prefetch(isLeafRef(c) ? static_cast<const void*>(&lights_.lights[leafLight(c)])
+                                          : static_cast<const void*>(&tree.nodes[c]));
+        if (freshCount < 2) fresh[freshCount++] = {t, left, right};
         const float lo = luminance(lower);
         float spread = visible && !boundary ? std::max(0.0f, b - lo) : b;
         // Where the contribution is smooth over the cluster and its representative is
@@ -287,26 +299,26 @@ class Lightcuts final : public LightEvaluator {
         const bool fo = firstOrder && smooth && found == CutVisibility::Visible;
         // Its moments are read at the end if it stays in the cut: a miss there cost 17% of
         // the cut loop (perf, 100k point lights).
-        if (fo) __builtin_prefetch(&tree.moments[(n.left - 1) / 2]);
+        if (fo) __builtin_prefetch(&tree.moments[ni]);
         const bool scaled = rss && fo && !boundary;
         (scaled ? sumScaled : sumSq) += double(spread) * spread;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
-        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, n.left, n.rep, n.lights, fo, scaled});
+        nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, left, right, n.rep, n.lights(),
+                                LightNode::leftPre(pre), n.rightPre(pre), fo, scaled});
       } else if (record) {
-        record1(t, ni, found, false);
+        record1(t, pre, found, false);
       }
     };
 
     uint32_t cutRoots = 0;
     for (uint32_t t = 0; t < forest_.trees.size(); ++t) {
       const LightTree& tree = forest_.trees[t];
-      if (tree.nodes.empty()) continue;
-      const LightNode& root = tree.nodes[0];
+      if (tree.empty()) continue;
       ShadowResult shadow;
-      const Light& rootRep = lights_.lights[root.rep];
+      const Light& rootRep = lights_.lights[tree.repOf(tree.root)];
       Color unit = shadowedUnit(rootRep, lights_.groups[rootRep.group], sp, vis, stats, shadow,
-                                probes && tree.lightCount(0) >= kProbeMinLights);
-      addNode(t, 0, unit, shadow);
+                                probes && tree.lightCount(tree.root) >= kProbeMinLights);
+      addNode(t, tree.root, 0, unit, shadow);
       ++cutRoots;
     }
     // The budget grows by one node per tree after the first: a forest of more trees than
@@ -337,7 +349,7 @@ class Lightcuts final : public LightEvaluator {
         // Its representative is hidden, and so is the whole cluster: it stays in the cut,
         // exactly 0, instead of being refined down to its lights.
         ++stats.hiddenClusters;
-        if (record) record1(cn.tree, cn.node, CutVisibility::Occluded, false);
+        if (record) record1(cn.tree, cn.leftPre - 1, CutVisibility::Occluded, false);
         continue;
       }
       total -= cn.estimate;
@@ -345,7 +357,8 @@ class Lightcuts final : public LightEvaluator {
       ShadowResult shadows[2];
       Color units[2];
       for (uint32_t k = 0; k < 2; ++k) {
-        const uint32_t c = cn.left + k, rep = tree.nodes[c].rep;
+        const NodeRef c = k ? cn.right : cn.left;
+        const uint32_t rep = tree.repOf(c);
         // The child that shares the parent's representative reuses its shadow ray.
         // Only clusters that may be probed need to know what hid their representative.
         shadows[k] = cn.shadow;
@@ -362,15 +375,16 @@ class Lightcuts final : public LightEvaluator {
         ++refinedTested;
         refinedSplit += boundary;
       }
-      for (uint32_t k = 0; k < 2; ++k) addNode(cn.tree, cn.left + k, units[k], shadows[k], boundary);
+      addNode(cn.tree, cn.left, cn.leftPre, units[0], shadows[0], boundary);
+      addNode(cn.tree, cn.right, cn.rightPre, units[1], shadows[1], boundary);
       // A second stage of prefetching: the children of the nodes pushed one refinement ago
       // have arrived (addNode fetched them); fetch their representatives' lights, which the
       // next refinement's shadow ray reads (a miss on the light was half of
       // lightContribution's time, perf on 100k point lights).
       for (uint32_t k = 0; k < pendingCount; ++k) {
-        const LightNode* kids = &forest_.trees[pending[k].first].nodes[pending[k].second];
-        __builtin_prefetch(&lights_.lights[kids[0].rep]);
-        __builtin_prefetch(&lights_.lights[kids[1].rep]);
+        const LightTree& ptree = forest_.trees[pending[k].tree];
+        for (NodeRef c : {pending[k].left, pending[k].right})
+          if (!isLeafRef(c)) __builtin_prefetch(&lights_.lights[ptree.nodes[c].rep]);
       }
       pendingCount = freshCount;
       for (uint32_t k = 0; k < freshCount; ++k) pending[k] = fresh[k];
@@ -386,7 +400,7 @@ class Lightcuts final : public LightEvaluator {
         if (!cn.firstOrder) continue;
         const LightTree& tree = forest_.trees[cn.tree];
         __builtin_prefetch(&tree.nodes[cn.node]);
-        __builtin_prefetch(&tree.moments[(cn.left - 1) / 2]);
+        __builtin_prefetch(&tree.moments[cn.node]);
         __builtin_prefetch(&lights_.lights[cn.rep]);
       }
     }
@@ -411,7 +425,7 @@ class Lightcuts final : public LightEvaluator {
         // A first-order node is never a leaf: its moments are stored.
         const Light& rep = lights_.lights[cn.rep];
         Color fo = vmax(firstOrderUnit(rep, lights_.groups[rep.group], sp,
-                                       tree.moments[(cn.left - 1) / 2], cn.unit) * n.intensity, Color(0));
+                                       tree.moments[cn.node], cn.unit) * n.intensity, Color(0));
         float raw = luminance(cn.estimate), lf = luminance(fo);
         if (raw > 0 && lf > 0) {
           float kept = std::clamp(lf, cn.lower, cn.upper);
@@ -421,7 +435,7 @@ class Lightcuts final : public LightEvaluator {
           factor = std::clamp(kept / raw, 0.5f, 2.0f);
         }
       }
-      if (record) record1(cn.tree, cn.node, cn.shadow.found, cn.firstOrder, factor);
+      if (record) record1(cn.tree, cn.leftPre - 1, cn.shadow.found, cn.firstOrder, factor);
     }
     if (record) {
       // The cut: the nodes left in the heap, and the exact ones recorded as they came.
@@ -450,27 +464,27 @@ class Lightcuts final : public LightEvaluator {
   // The unshadowed sum of a directional cluster's lights at sp, times a visibility: 1 when
   // its representative was found visible (`found`), else (the representative is behind the
   // surface and cast no ray) that of its brightest light, one shadow ray.
-  Color exactDirectionalSum(const LightTree& tree, uint32_t node, const ShadingPoint& sp, Visibility& vis,
+  Color exactDirectionalSum(const LightTree& tree, NodeRef node, const ShadingPoint& sp, Visibility& vis,
                             EvalStats& stats, CutVisibility found) const {
-    static thread_local std::vector<uint32_t> stack;
+    static thread_local std::vector<NodeRef> stack;
     stack.assign(1, node);
     Vec3d sum;
     float brightest = 0;
     Vec3 brightestDir;
     while (!stack.empty()) {
-      const LightNode& n = tree.nodes[stack.back()];
+      const NodeRef r = stack.back();
       stack.pop_back();
-      if (!n.isLeaf()) {
-        stack.push_back(n.left);
-        stack.push_back(n.left + 1);
+      if (!isLeafRef(r)) {
+        stack.push_back(tree.nodes[r].left(r));
+        stack.push_back(tree.nodes[r].right(r));
         continue;
       }
       Color mg;
       Vec3 wi;
       float dist;
-      const Light& l = lights_.lights[n.rep];
+      const Light& l = lights_.lights[leafLight(r)];
       if (!lightContribution(l, lights_.groups[l.group], sp, mg, wi, dist)) continue;
-      Color c = mg * n.intensity;
+      Color c = mg * leafIntensity(l);
       sum += c;
       if (luminance(c) > brightest) {
         brightest = luminance(c);
@@ -546,7 +560,7 @@ class CourseCuts final : public LightEvaluator {
     Color total(0);
     uint32_t cutSize = 0;
     for (uint32_t t = 0; t < forest_.trees.size(); ++t)
-      if (!forest_.trees[t].nodes.empty()) stack.emplace_back(t, 0u);
+      if (!forest_.trees[t].empty()) stack.emplace_back(t, forest_.trees[t].root);
     // As for lightcuts: one more node per tree after the first.
     const size_t maxCut = size_t(opt_.maxCut) + std::max<size_t>(stack.size(), 1) - 1;
     while (!stack.empty()) {
@@ -554,22 +568,24 @@ class CourseCuts final : public LightEvaluator {
       stack.pop_back();
       const LightTree& tree = forest_.trees[t];
       const LightGroup& g = tree.bound;  // the synthetic light's (a leaf uses its own)
-      const LightNode& n = tree.nodes[ni];
-      if (!n.isLeaf()) {
+      if (!isLeafRef(ni)) {
+        const LightNode& n = tree.nodes[ni];
         const CourseNodeData& sd = seed_[t][ni];
         float dist = tree.type == LightType::Directional ? 1.0f : length(sp.p - sd.position);
         if (sd.error > opt_.errorRatio * dist && cutSize + stack.size() + 2 <= maxCut) {
-          stack.emplace_back(t, n.left);
-          stack.emplace_back(t, n.left + 1);
+          stack.emplace_back(t, n.left(ni));
+          stack.emplace_back(t, n.right(ni));
           continue;
         }
       }
       bool blocked = false;
       Color c = nodeLight(tree, seed_[t], g, ni, sp, vis, stats, blocked);
       if (blocked) {
-        // The seed's fallback: a blocked representative may hide lights that are visible;
-        // its two children (one level only) stand in for it.
-        for (uint32_t k = n.left; k <= n.left + 1; ++k) {
+        // The seed's fallback: a blocked representative (of an inner node: a leaf is never
+        // `blocked`) may hide lights that are visible; its two children (one level only)
+        // stand in for it.
+        const LightNode& n = tree.nodes[ni];
+        for (NodeRef k : {n.left(ni), n.right(ni)}) {
           bool unused;
           total += nodeLight(tree, seed_[t], g, k, sp, vis, stats, unused);
         }
@@ -588,15 +604,15 @@ class CourseCuts final : public LightEvaluator {
   // The contribution of a node's light: the light itself at a leaf, the synthetic
   // centroid light otherwise (its visibility measured toward the node's representative
   // light). `blocked` is set when an inner node's light is non-zero but fully occluded.
-  Color nodeLight(const LightTree& tree, const CourseNodeData* seed, const LightGroup& g, uint32_t ni,
+  Color nodeLight(const LightTree& tree, const CourseNodeData* seed, const LightGroup& g, NodeRef ni,
                   const ShadingPoint& sp, Visibility& vis, EvalStats& stats, bool& blocked) const {
-    const LightNode& n = tree.nodes[ni];
     blocked = false;
     ShadowResult found;
-    if (n.isLeaf()) {
-      const Light& l = lights_.lights[n.rep];
-      return shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, found) * n.intensity;
+    if (isLeafRef(ni)) {
+      const Light& l = lights_.lights[leafLight(ni)];
+      return shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, found) * leafIntensity(l);
     }
+    const LightNode& n = tree.nodes[ni];
     const CourseNodeData& sd = seed[ni];
     Light syn;
     syn.type = tree.type;

@@ -160,34 +160,34 @@ TEST(Lightcuts, RefinesTheLargestBoundFirst) {
   Unoccluded vis;
   ShadingPoint sp = point(Vec3(0.3f, 0, -0.2f));
   BoundFrames fr(sp);
-  auto unit = [&](uint32_t ni) {
+  auto unit = [&](NodeRef ni) {
     Color mg;
     Vec3 wi;
     float d;
-    return lightContribution(s.lights[t.nodes[ni].rep], g, sp, mg, wi, d) ? mg : Color(0);
+    return lightContribution(s.lights[t.repOf(ni)], g, sp, mg, wi, d) ? mg : Color(0);
   };
   for (uint32_t maxCut : {1u, 2u, 17u, 100u, 333u, 1500u}) {
-    std::priority_queue<std::pair<float, uint32_t>> heap;
+    std::priority_queue<std::pair<float, NodeRef>> heap;
     Color expect(0);
     uint32_t size = 0;
-    auto add = [&](uint32_t ni) {
+    auto add = [&](NodeRef ni) {
       ++size;
-      const LightNode& n = t.nodes[ni];
-      float b = n.isLeaf() ? 0.0f : luminance(clusterBound(n, t.type, g, sp, fr));
+      const LightNode n = t.node(s, ni);
+      float b = isLeafRef(ni) ? 0.0f : luminance(clusterBound(n, t.type, g, sp, fr));
       if (b > 0)
         heap.push({b, ni});
       else
         expect += unit(ni) * n.intensity;
     };
-    add(0);
+    add(t.root);
     while (!heap.empty() && size < maxCut) {
-      uint32_t ni = heap.top().second;
+      NodeRef ni = heap.top().second;
       heap.pop();
       --size;
-      add(t.nodes[ni].left);
-      add(t.nodes[ni].left + 1);
+      add(t.nodes[ni].left(ni));
+      add(t.nodes[ni].right(ni));
     }
-    for (; !heap.empty(); heap.pop()) expect += unit(heap.top().second) * t.nodes[heap.top().second].intensity;
+    for (; !heap.empty(); heap.pop()) expect += unit(heap.top().second) * t.node(s, heap.top().second).intensity;
     // The representative's estimate, as the replay computes it.
     auto lcut = makeLightcuts(s, f, CutOptions{0.0f, int(maxCut), CutCriterion::Walter, Estimator::Representative});
     EvalStats st;
@@ -245,7 +245,7 @@ TEST(CourseCuts, BlockedRepresentativeFallsBackToChildren) {
   LightForest f = buildLightForest(s, TreeBuildOptions{TreeBuilder::Course, 1});
   // The centroid light's visibility is taken toward the root's representative light:
   // block exactly that light; the other child is visible.
-  float blockedX = s.lights[f.trees[0].nodes[0].rep].position.x;
+  float blockedX = s.lights[f.trees[0].repOf(f.trees[0].root)].position.x;
   struct BlockOne : Visibility {
     float x;
     Color operator()(const Vec3& wi, float) override { return wi.x * x > 0 ? Color(0) : Color(1); }
@@ -462,25 +462,27 @@ TEST(MixedGroups, ManyConesShareOneTreeAndStayWithinTheError) {
   for (int k = 0; k < 8; ++k) {
     ShadingPoint sp = point(Vec3(r.uniform() * 4 - 2, 0, r.uniform() * 4 - 2));
     BoundFrames fr(sp);
-    for (uint32_t ni = 0; ni < t.nodes.size(); ni += 7) {
-      std::vector<uint32_t> stack{ni};
+    const std::vector<NodeRef> all = t.preorderNodes();
+    for (size_t k7 = 0; k7 < all.size(); k7 += 7) {
+      const NodeRef ni = all[k7];
+      std::vector<NodeRef> stack{ni};
       double sum = 0;
       while (!stack.empty()) {
-        const LightNode& n = t.nodes[stack.back()];
+        const NodeRef r = stack.back();
         stack.pop_back();
-        if (!n.isLeaf()) {
-          stack.push_back(n.left);
-          stack.push_back(n.left + 1);
+        if (!isLeafRef(r)) {
+          stack.push_back(t.nodes[r].left(r));
+          stack.push_back(t.nodes[r].right(r));
           continue;
         }
         Color mg;
         Vec3 wi;
         float d;
-        const Light& l = s.lights[n.rep];
+        const Light& l = s.lights[leafLight(r)];
         if (lightContribution(l, s.groups[l.group], sp, mg, wi, d)) sum += luminance(mg * l.intensity);
       }
       Color lower;
-      Color upper = clusterBounds(t.nodes[ni], t.type, t.bound, sp, fr, &lower, nullptr, &t.boundLow);
+      Color upper = clusterBounds(t.node(s, ni), t.type, t.bound, sp, fr, &lower, nullptr, &t.boundLow);
       EXPECT_GE(double(luminance(upper)), sum * (1 - 1e-5)) << "node " << ni;
       EXPECT_LE(double(luminance(lower)), sum * (1 + 1e-5) + 1e-12) << "node " << ni;
     }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <unordered_map>
 #include <stdexcept>
@@ -17,15 +18,62 @@ size_t LightForest::memoryBytes() const {
   size_t b = 0;
   for (const LightTree& t : trees)
     b += t.nodes.size() * sizeof(LightNode) + t.course.size() * sizeof(CourseNodeData) +
-         t.moments.size() * sizeof(NodeMoments) +
-         t.preorder.size() * sizeof(uint32_t);
+         t.moments.size() * sizeof(NodeMoments);
   return b;
 }
 
 size_t LightForest::nodeCount() const {
   size_t n = 0;
-  for (const LightTree& t : trees) n += t.nodes.size();
+  for (const LightTree& t : trees) n += t.empty() ? 0 : 2 * size_t(t.lightTotal) - 1;
   return n;
+}
+
+namespace {
+// computeDirectionCones widens each cone by this angle (radians).
+constexpr double kConeMargin = 1e-3;
+Vec3d unitd(const Vec3d& v) {
+  double l = std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+  return l > 0 ? v / l : Vec3d(0, 0, 1);
+}
+// The stored cosine of a cone of half-angle `angle`, widened (computeDirectionCones).
+float widenedCos(double angle) {
+  const double widened = angle + kConeMargin;
+  return widened >= kPi ? -1.0f : std::nextafter(float(std::cos(widened)), -1.0f);
+}
+}  // namespace
+
+LightNode LightTree::leafNode(const Light& l, uint32_t index) const {
+  LightNode n;
+  n.lo = n.hi = l.type == LightType::Directional ? -l.direction : l.position;
+  if (type == LightType::Directional) {
+    n.axis = unitd(Vec3d(l.direction)).toFloat();
+    n.cosHalfAngle = widenedCos(0);
+  } else if (l.type == LightType::Oriented || l.type == LightType::Spot) {
+    n.axis = l.direction;
+    n.cosHalfAngle = 1;
+  } else {
+    n.axis = Vec3(0, 0, 1);
+    n.cosHalfAngle = -1;
+  }
+  n.intensity = leafIntensity(l);
+  n.rep = index;
+  return n;
+}
+
+std::vector<NodeRef> LightTree::preorderNodes() const {
+  std::vector<NodeRef> out;
+  if (empty()) return out;
+  out.reserve(2 * size_t(lightTotal) - 1);
+  std::vector<NodeRef> stack{root};
+  while (!stack.empty()) {
+    NodeRef r = stack.back();
+    stack.pop_back();
+    out.push_back(r);
+    if (isLeafRef(r)) continue;
+    stack.push_back(nodes[r].right(r));
+    stack.push_back(nodes[r].left(r));
+  }
+  return out;
 }
 
 void coneUnion(const Vec3& a, float cosA, const Vec3& b, float cosB, Vec3& axis, float& cosOut) {
@@ -115,51 +163,44 @@ void setMeans(NodeMoments& m, const MomentSums& s) {
 }
 
 // Post-order walk with an explicit stack (chains of merges can be deep): fills the moments
-// below `top` and returns top's sums. `known(i, sums)` may supply a subtree's sums.
+// below `top` and returns top's sums. `known(r, sums)` may supply a subtree's sums.
 template <class Known>
-MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, uint32_t top, const Known& known) {
+MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, NodeRef top, const Known& known) {
   BigVector<NodeMoments>& m = tree.moments;
-  std::vector<std::pair<uint32_t, bool>> stack{{top, false}};  // node, children done
+  std::vector<std::pair<NodeRef, bool>> stack{{top, false}};  // node, children done
   std::vector<MomentSums> done;  // the finished subtrees whose parent is not
   while (!stack.empty()) {
-    auto [i, expanded] = stack.back();
+    auto [r, expanded] = stack.back();
     stack.pop_back();
-    const LightNode& n = tree.nodes[i];
     MomentSums ks;
-    if (!expanded && known(i, ks)) {
+    if (!expanded && known(r, ks)) {
       done.push_back(ks);
       continue;
     }
-    if (n.isLeaf()) {
-      // From the leaf's node, not its light: leaves come in tree order and their lights in
-      // scene order, a cache miss each (half of this pass at 8.1M lights). The node holds the
-      // light's position (directional: the direction toward it, minus its travel direction)
-      // and, for oriented and spot lights, its axis. (An omni light's node has no axis: its
-      // light is read, to keep the moments momentsOf() defines, though nothing reads an omni
-      // tree's mean axis.)
+    if (isLeafRef(r)) {
+      const Light& l = lights.lights[leafLight(r)];
+      const LightNode n = tree.leafNode(l, leafLight(r));
       MomentSums s;
       s.w = lum(n.intensity);
       s.n = 1;
       s.posU = Vec3d(n.lo);
-      s.axisU = tree.type == LightType::Directional ? Vec3d(-n.lo)
-                : tree.type == LightType::Omni      ? Vec3d(lights.lights[n.rep].direction)
-                                                    : Vec3d(n.axis);
+      s.axisU = Vec3d(tree.type == LightType::Directional ? -n.lo : l.direction);
       s.pos = s.posU * s.w;
       s.axis = s.axisU * s.w;
       done.push_back(s);
       continue;
     }
+    const LightNode& n = tree.nodes[r];
     if (!expanded) {
-      stack.emplace_back(i, true);
-      stack.emplace_back(n.left + 1, false);
-      stack.emplace_back(n.left, false);
+      stack.emplace_back(r, true);
+      stack.emplace_back(n.right(r), false);
+      stack.emplace_back(n.left(r), false);
       continue;
     }
     MomentSums b = done.back();
     done.pop_back();
     done.back().add(b);  // the left child's sums become this node's
-    NodeMoments& mi = m[(n.left - 1) / 2];
-    setMeans(mi, done.back());
+    setMeans(m[r], done.back());
   }
   return done.back();
 }
@@ -174,34 +215,31 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
   // node's sums are its left child's plus its right child's, so the subtrees below the
   // top levels are summed in parallel to the same values. Memory: the tree's depth.
   BigVector<NodeMoments>& m = tree.moments;
-  m.assign(tree.nodes.size() / 2, NodeMoments{});  // one per inner node
-  if (tree.nodes.empty()) return;
-  if (tree.preorder.size() != tree.nodes.size()) computePreorder(tree);
-  // Top levels: split down to subtrees of at most kTask lights. A node's light count from
-  // the preorder: the left subtree spans preorder[right] - preorder[left] = 2 count - 1.
+  m.resize(tree.nodes.size());  // one per inner node, each written below
+  if (tree.empty() || isLeafRef(tree.root)) return;
+  // Top levels: split down to subtrees of at most kTask lights.
   constexpr uint32_t kTask = 1u << 14;
-  std::vector<uint32_t> tasks;
-  std::unordered_map<uint32_t, uint32_t> taskOf;  // node -> task
-  std::vector<std::pair<uint32_t, uint32_t>> stack{{0u, uint32_t((tree.nodes.size() + 1) / 2)}};
+  std::vector<NodeRef> tasks;
+  std::unordered_map<NodeRef, uint32_t> taskOf;  // node -> task
+  std::vector<NodeRef> stack{tree.root};
   while (!stack.empty()) {
-    auto [i, count] = stack.back();
+    NodeRef r = stack.back();
     stack.pop_back();
-    const LightNode& n = tree.nodes[i];
-    if (n.isLeaf() || count <= kTask) {
-      taskOf.emplace(i, uint32_t(tasks.size()));
-      tasks.push_back(i);
+    if (tree.lightCount(r) <= kTask) {
+      taskOf.emplace(r, uint32_t(tasks.size()));
+      tasks.push_back(r);
       continue;
     }
-    uint32_t leftCount = (tree.preorder[n.left + 1] - tree.preorder[n.left] + 1) / 2;
-    stack.emplace_back(n.left + 1, count - leftCount);
-    stack.emplace_back(n.left, leftCount);
+    const LightNode& n = tree.nodes[r];
+    stack.push_back(n.right(r));
+    stack.push_back(n.left(r));
   }
   std::vector<MomentSums> sums(tasks.size());
-  auto none = [](uint32_t, MomentSums&) { return false; };
+  auto none = [](NodeRef, MomentSums&) { return false; };
   tbb::parallel_for(size_t(0), tasks.size(),
                     [&](size_t k) { sums[k] = subtreeMoments(lights, tree, tasks[k], none); });
-  subtreeMoments(lights, tree, 0, [&](uint32_t i, MomentSums& s) {
-    auto t = taskOf.find(i);
+  subtreeMoments(lights, tree, tree.root, [&](NodeRef r, MomentSums& s) {
+    auto t = taskOf.find(r);
     if (t == taskOf.end()) return false;
     s = sums[t->second];
     return true;
@@ -209,113 +247,105 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
 }
 
 void computeCourseData(const LightSet& lights, LightTree& tree) {
-  if (tree.moments.size() != tree.nodes.size() / 2) computeMoments(lights, tree);
+  if (tree.moments.size() != tree.nodes.size()) computeMoments(lights, tree);
   tree.course = courseNodeData(lights, tree);
 }
 
 std::vector<CourseNodeData> courseNodeData(const LightSet& lights, const LightTree& tree) {
-  // Bottom-up, from the moments. The mean distance to the centroid is exact for leaves and
-  // bounded above through the triangle inequality for inner nodes; the seed builder
-  // overwrites it with exact values.
+  // Bottom-up (slots in reverse: children after parents), from the moments. The mean
+  // distance to the centroid is exact for leaves and bounded above through the triangle
+  // inequality for inner nodes; the seed builder overwrites it with exact values.
   std::vector<CourseNodeData> sd(tree.nodes.size(), CourseNodeData{});
   std::vector<float> spread(tree.nodes.size(), 0.0f);
   auto chroma = [](const Color& c) {
     double s = double(c.x) + c.y + c.z;  // in double: the float sum may overflow
     return s > 0 ? Color(float(c.x / s), float(c.y / s), float(c.z / s)) : Color(1.0f / 3);
   };
+  // A child's data, intensity and colour spread: a leaf's from its light.
+  struct Child {
+    CourseNodeData d;
+    Color intensity;
+    float spread;
+  };
+  auto child = [&](NodeRef r) {
+    if (!isLeafRef(r)) return Child{sd[r], tree.nodes[r].intensity, spread[r]};
+    const NodeMoments mo = tree.momentsOf(lights, r);
+    return Child{CourseNodeData{mo.centroid, mo.meanAxis, 0}, tree.node(lights, r).intensity, 0.0f};
+  };
   for (size_t i = tree.nodes.size(); i-- > 0;) {
     const LightNode& n = tree.nodes[i];
     CourseNodeData& d = sd[i];
-    const NodeMoments mo = tree.momentsOf(lights, i);
+    const NodeMoments& mo = tree.moments[i];
     d.position = mo.centroid;
-    if (n.isLeaf()) {
-      d.direction = mo.meanAxis;
-      d.error = 0;
-      continue;
-    }
-    const CourseNodeData& da = sd[n.left];
-    const CourseNodeData& db = sd[n.left + 1];
+    const Child ca = child(n.left(NodeRef(i))), cb = child(n.right(NodeRef(i)));
+    const CourseNodeData& da = ca.d;
+    const CourseNodeData& db = cb.d;
     d.direction = length2(mo.meanAxis) > 0 ? normalize(mo.meanAxis) : da.direction;
     // Relative weights (in double: luminances near FLT_MAX would overflow their sum).
-    double la = lum(tree.nodes[n.left].intensity), lb = lum(tree.nodes[n.left + 1].intensity);
+    double la = lum(ca.intensity), lb = lum(cb.intensity);
     float wa = 0.5f, wb = 0.5f, w = 1;
     if (la + lb > 0) wa = float(la / (la + lb)), wb = float(lb / (la + lb));
-    float meanDist = (wa * (da.error / (1 + spread[n.left]) + length(da.position - d.position)) +
-                      wb * (db.error / (1 + spread[n.left + 1]) + length(db.position - d.position))) / w;
+    float meanDist = (wa * (da.error / (1 + ca.spread) + length(da.position - d.position)) +
+                      wb * (db.error / (1 + cb.spread) + length(db.position - d.position))) / w;
     Color cm = chroma(n.intensity);
-    Vec3 ca = vabs(chroma(tree.nodes[n.left].intensity) - cm), cb = vabs(chroma(tree.nodes[n.left + 1].intensity) - cm);
-    spread[i] = (wa * (spread[n.left] + ca.x + ca.y + ca.z) + wb * (spread[n.left + 1] + cb.x + cb.y + cb.z)) / w;
+    Vec3 xa = vabs(chroma(ca.intensity) - cm), xb = vabs(chroma(cb.intensity) - cm);
+    spread[i] = (wa * (ca.spread + xa.x + xa.y + xa.z) + wb * (cb.spread + xb.x + xb.y + xb.z)) / w;
     d.error = meanDist * (1 + spread[i]);
   }
   return sd;
 }
 
-void computePreorder(LightTree& tree) {
-  tree.preorder.assign(tree.nodes.size(), 0);
-  if (tree.nodes.empty()) return;
-  std::vector<uint32_t> stack{0};
-  uint32_t next = 0;
-  while (!stack.empty()) {
-    uint32_t i = stack.back();
-    stack.pop_back();
-    tree.preorder[i] = next++;
-    const LightNode& n = tree.nodes[i];
-    if (n.isLeaf()) continue;
-    stack.push_back(n.left + 1);
-    stack.push_back(n.left);
-  }
-}
-
 void computeDirectionCones(const LightSet& lights, LightTree& tree) {
-  // Bottom-up in double: each inner node's cone is the smallest cone holding its children's
-  // (as coneUnion), so a node's cone holds every light below it. A float cosine cannot
-  // tell half-angles below ~3.5e-4 apart (cos rounds to 1), so each node stores
-  // cos(half-angle + kMargin), rounded down: the angle it stands for is never too small.
-  constexpr double kMargin = 1e-3;
+  // Bottom-up in double (slots in reverse: children after parents): each inner node's cone
+  // is the smallest cone holding its children's (as coneUnion), so a node's cone holds
+  // every light below it. A float cosine cannot tell half-angles below ~3.5e-4 apart (cos
+  // rounds to 1), so each node stores cos(half-angle + kConeMargin), rounded down: the angle
+  // it stands for is never too small. A leaf's cone (LightTree::leafNode) is its light's
+  // direction, widened alike.
   const size_t n = tree.nodes.size();
   std::vector<Vec3d> axis(n);
   std::vector<double> angle(n);
-  auto unit = [](const Vec3d& v) {
-    double l = std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-    return l > 0 ? v / l : Vec3d(0, 0, 1);
-  };
   auto dotd = [](const Vec3d& a, const Vec3d& b) { return a.x * b.x + a.y * b.y + a.z * b.z; };
+  auto cone = [&](NodeRef r, Vec3d& ax, double& an) {
+    if (isLeafRef(r)) {
+      ax = unitd(Vec3d(lights.lights[leafLight(r)].direction));
+      an = 0;
+    } else {
+      ax = axis[r];
+      an = angle[r];
+    }
+  };
   for (size_t i = n; i-- > 0;) {
     LightNode& nd = tree.nodes[i];
-    if (nd.isLeaf()) {
-      axis[i] = unit(Vec3d(lights.lights[nd.rep].direction));
-      angle[i] = 0;
+    Vec3d a, b;
+    double ta, tb;
+    cone(nd.left(NodeRef(i)), a, ta);
+    cone(nd.right(NodeRef(i)), b, tb);
+    const double ab = std::clamp(dotd(a, b), -1.0, 1.0), td = std::acos(ab);
+    if (ta >= kPi || tb >= kPi) {
+      axis[i] = a;
+      angle[i] = kPi;
+    } else if (td + tb <= ta) {
+      axis[i] = a;
+      angle[i] = ta;
+    } else if (td + ta <= tb) {
+      axis[i] = b;
+      angle[i] = tb;
     } else {
-      const Vec3d a = axis[nd.left], b = axis[nd.left + 1];
-      const double ta = angle[nd.left], tb = angle[nd.left + 1];
-      const double ab = std::clamp(dotd(a, b), -1.0, 1.0), td = std::acos(ab);
-      if (ta >= kPi || tb >= kPi) {
+      const double to = (ta + td + tb) * 0.5;
+      Vec3d t = b - a * ab;  // toward b, orthogonal to a
+      double tl = std::sqrt(dotd(t, t));
+      if (to >= kPi || !(tl > 1e-12)) {
         axis[i] = a;
         angle[i] = kPi;
-      } else if (td + tb <= ta) {
-        axis[i] = a;
-        angle[i] = ta;
-      } else if (td + ta <= tb) {
-        axis[i] = b;
-        angle[i] = tb;
       } else {
-        const double to = (ta + td + tb) * 0.5;
-        Vec3d t = b - a * ab;  // toward b, orthogonal to a
-        double tl = std::sqrt(dotd(t, t));
-        if (to >= kPi || !(tl > 1e-12)) {
-          axis[i] = a;
-          angle[i] = kPi;
-        } else {
-          const double phi = to - ta;  // rotate a toward b by this much
-          axis[i] = unit(a * std::cos(phi) + t * (std::sin(phi) / tl));
-          angle[i] = to;
-        }
+        const double phi = to - ta;  // rotate a toward b by this much
+        axis[i] = unitd(a * std::cos(phi) + t * (std::sin(phi) / tl));
+        angle[i] = to;
       }
     }
-    const double widened = angle[i] + kMargin;
     nd.axis = axis[i].toFloat();
-    nd.cosHalfAngle =
-        widened >= kPi ? -1.0f : std::nextafter(float(std::cos(widened)), -1.0f);
+    nd.cosHalfAngle = widenedCos(angle[i]);
   }
 }
 
@@ -347,6 +377,9 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
     mixed.insert(mixed.end(), it->second.begin(), it->second.end());
     it = groups.erase(it);
   }
+  for (auto& [k, v] : groups)
+    if (v.size() > kMaxTreeLights)
+      throw Error("more than " + std::to_string(kMaxTreeLights) + " lights of one kind: a light tree holds at most that many");
   LightForest forest;
   forest.trees.resize(groups.size());
   std::vector<std::pair<GroupKey, const std::vector<uint32_t>*>> work;
@@ -375,10 +408,9 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
         }
       }
       t = buildAgglomerativeTree(lights, idx, k.type, c, seed, std::max<size_t>(options.exactLimit, 2), &progress);
-      // The builder fills the preorder and the moments.
+      // The builder fills the moments.
       if (options.courseData) computeCourseData(lights, t);
     }
-    if (t.preorder.size() != t.nodes.size()) computePreorder(t);
     if (k.type == LightType::Directional) computeDirectionCones(lights, t);
     t.type = k.type;
     if (k.group < kMixedKey) {

@@ -1,7 +1,8 @@
-// Light trees: binary trees of light clusters. Each node stores what the Lightcuts error
-// bounds need (bounding box, cone of light normals, summed intensity, a representative
-// light) and, in parallel arrays, the first moments and preorder positions that the
-// first-order estimate and the reconstruction cuts need. What the seed's traversal needs
+// Light trees: binary trees of light clusters. Each inner node stores what the Lightcuts
+// error bounds need (bounding box, cone of light normals, summed intensity, a
+// representative light) and, in a parallel array, the first moments that the first-order
+// estimate needs; a leaf is its light, stored nowhere else (NodeRef). Nodes sit in preorder,
+// so walks that need a node's preorder position (reconstruction cuts) carry it down. What the seed's traversal needs
 // (intensity-weighted centroid and direction, and its error radius) the seed builder
 // stores; for other trees the seed's evaluator computes it when it is made.
 //
@@ -29,7 +30,17 @@
 
 namespace lc::lightcuts {
 
-// 64 bytes: one cache line.
+// A node as its readers name it: an inner node by its slot (how many inner nodes come
+// before it in preorder: the root's is 0, a left child's its parent's + 1), a leaf by its
+// light's index with kLeafRef set. A tree stores only its inner nodes; a leaf is its light.
+using NodeRef = uint32_t;
+constexpr NodeRef kLeafRef = 1u << 31;
+inline bool isLeafRef(NodeRef r) { return (r & kLeafRef) != 0; }
+inline NodeRef leafRef(uint32_t light) { return kLeafRef | light; }
+inline uint32_t leafLight(NodeRef r) { return r & ~kLeafRef; }
+
+// 64 bytes: one cache line. Stored for inner nodes; a leaf's is made from its light
+// (LightTree::node), its children fields then 0.
 struct LightNode {
   Vec3 lo, hi;          // bounds of light positions (directional trees: of directions to the light)
   Vec3 axis;            // cone of light normals/axes (oriented, spot), of the lights' travel
@@ -37,12 +48,42 @@ struct LightNode {
   float cosHalfAngle;   // cone half-angle's cosine; -1 = all directions
   Color intensity;      // summed RGB intensity of the cluster
   uint32_t rep;         // representative light (index into LightSet::lights)
-  uint32_t left;        // first child (the second is left + 1); 0 = leaf
-  uint32_t lights;      // how many lights the cluster holds (1 for a leaf): read by every
-                        // refinement (visibility probes), so it sits in the node, not beside it
-  bool isLeaf() const { return left == 0; }
+  // The children, packed so that a node alone says where both are and how many lights it
+  // holds (every refinement reads the count, for the visibility probes): a leaf child by
+  // its light; an inner left child is the next slot, an inner right child the slot after
+  // the left subtree's inner nodes (self + left count). a = left leaf ? its light : the
+  // left subtree's light count, with kLeftLeaf and kRightLeaf; b = right leaf ? its light :
+  // this node's light count.
+  uint32_t a = 0, b = 0;
+
+  static constexpr uint32_t kLeftLeaf = 1u << 31, kRightLeaf = 1u << 30, kValue = kRightLeaf - 1;
+  bool leftIsLeaf() const { return (a & kLeftLeaf) != 0; }
+  bool rightIsLeaf() const { return (a & kRightLeaf) != 0; }
+  uint32_t leftLights() const { return leftIsLeaf() ? 1 : a & kValue; }
+  uint32_t lights() const { return rightIsLeaf() ? leftLights() + 1 : b; }  // inner nodes only
+  // The children of this node, stored at slot `self`.
+  NodeRef left(NodeRef self) const { return leftIsLeaf() ? leafRef(a & kValue) : self + 1; }
+  NodeRef right(NodeRef self) const { return rightIsLeaf() ? leafRef(b) : self + leftLights(); }
+  // Preorder positions of the children, from this node's.
+  static uint32_t leftPre(uint32_t pre) { return pre + 1; }
+  uint32_t rightPre(uint32_t pre) const { return pre + 2 * leftLights(); }
+  // Sets the children: each a light (leaf) or a subtree of `count` lights.
+  void setChildren(bool leftLeaf, uint32_t leftLightOrCount, bool rightLeaf, uint32_t rightLight,
+                   uint32_t count) {
+    a = (leftLightOrCount & kValue) | (leftLeaf ? kLeftLeaf : 0) | (rightLeaf ? kRightLeaf : 0);
+    b = rightLeaf ? rightLight : count;
+  }
 };
 static_assert(sizeof(LightNode) == 64, "LightNode should fill one cache line");
+
+// A light's intensity in a node: clamped as inner nodes' sums are, so that a light of
+// infinite power keeps a finite node intensity.
+inline Color leafIntensity(const Light& l) {
+  return vmin(l.intensity, Color(std::numeric_limits<float>::max()));
+}
+
+// Light indices and light counts fit LightNode's 30-bit fields.
+constexpr size_t kMaxTreeLights = LightNode::kValue;
 
 // Per-node data of the seed's traversal: a synthetic light at the intensity-weighted
 // centroid, and the node's error radius.
@@ -70,28 +111,37 @@ struct LightTree {
   LightGroup bound;
   LightGroup boundLow;  // mixed trees: the groups' lower envelope, for lower bounds
   bool mixedGroups = false;
-  BigVector<LightNode> nodes;  // nodes[0] is the root
-  // Parallel to nodes when filled: the seed builder fills it; agglomerative trees leave it
-  // empty (unless TreeBuildOptions::courseData) and makeCourseCuts computes it on demand.
+  uint32_t lightTotal = 0;     // lights in the tree
+  BigVector<LightNode> nodes;  // the inner nodes by slot (preorder): nodes[0] is the root
+  // Per inner node, by slot: the seed builder fills it; agglomerative trees leave it empty
+  // (unless TreeBuildOptions::courseData) and makeCourseCuts computes it on demand.
   std::vector<CourseNodeData> course;
-  // Per inner node, at (left - 1) / 2: sibling pairs sit at nodes 1-2, 3-4, ..., so that is
-  // each inner node's own slot (n - 1 of them). A leaf's moments are its light's
-  // (momentsOf); storing them would repeat the light (24 bytes per light).
+  // Per inner node, by slot. A leaf's moments are its light's (momentsOf).
   BigVector<NodeMoments> moments;
-  // Parallel to nodes: each node's position in a depth-first walk that visits the left
-  // child (n.left) before the right one, so a subtree is a contiguous range. Reconstruction
-  // cuts (reconstruction.h) compare cuts of different points by it.
-  BigVector<uint32_t> preorder;
 
-  // Node i's moments: stored for inner nodes, made from the light for a leaf.
-  NodeMoments momentsOf(const LightSet& lights, uint32_t i) const {
-    const LightNode& n = nodes[i];
-    if (!n.isLeaf()) return moments[(n.left - 1) / 2];
-    const Light& l = lights.lights[n.rep];
+  NodeRef root = 0;  // slot 0, or a tree of one light: that light's leaf
+
+  bool empty() const { return lightTotal == 0; }
+  // Node r's LightNode: stored for an inner node, made from the light for a leaf.
+  LightNode node(const LightSet& lights, NodeRef r) const {
+    return isLeafRef(r) ? leafNode(lights.lights[leafLight(r)], leafLight(r)) : nodes[r];
+  }
+  // A leaf's node: the light's point, its cone (an exact cone for oriented and spot lights;
+  // directional trees: computeDirectionCones' cone of a single direction), its intensity.
+  LightNode leafNode(const Light& l, uint32_t index) const;
+  // Node r's moments: stored for inner nodes, made from the light for a leaf.
+  NodeMoments momentsOf(const LightSet& lights, NodeRef r) const {
+    if (!isLeafRef(r)) return moments[r];
+    const Light& l = lights.lights[leafLight(r)];
     return NodeMoments{l.type == LightType::Directional ? -l.direction : l.position, l.direction};
   }
-  // How many lights node i holds.
-  uint32_t lightCount(uint32_t i) const { return nodes[i].lights; }
+  // How many lights node r holds.
+  uint32_t lightCount(NodeRef r) const { return isLeafRef(r) ? 1 : nodes[r].lights(); }
+  // Node r's representative light.
+  uint32_t repOf(NodeRef r) const { return isLeafRef(r) ? leafLight(r) : nodes[r].rep; }
+  // Every node in preorder (a node's preorder position is its index here): for tests and
+  // for walks that want the whole tree.
+  std::vector<NodeRef> preorderNodes() const;
 };
 
 // Course: the course project's k-d split (`--tree seed` or `course`).
@@ -163,9 +213,6 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
 LightTree buildCourseTree(const LightSet& lights, const std::vector<uint32_t>& indices, LightType type,
                         uint64_t seed);
 
-// Fills LightTree::preorder (buildLightForest calls it).
-void computePreorder(LightTree& tree);
-
 // Directional trees: sets each node's cone (axis, cosHalfAngle) to one holding its
 // lights' travel directions, a little wider than needed so that float rounding never makes
 // it too narrow (buildLightForest calls it; the builders leave these trees without cones).
@@ -174,7 +221,7 @@ void computeDirectionCones(const LightSet& lights, LightTree& tree);
 // Fills LightTree::moments from the finished nodes (buildLightForest calls it).
 void computeMoments(const LightSet& lights, LightTree& tree);
 
-// Fills LightTree::seed from the finished nodes and their moments (centroids, mean
+// Fills LightTree::course from the finished nodes and their moments (centroids, mean
 // directions, errors).
 void computeCourseData(const LightSet& lights, LightTree& tree);
 // The same data, for a tree that has its moments, without touching the tree.

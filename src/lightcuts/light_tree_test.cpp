@@ -20,6 +20,8 @@ namespace lc::lightcuts {
 namespace {
 
 using test_lights::leafCount;
+using test_lights::rootLeft;
+using test_lights::rootRight;
 
 LightSet randomLights(size_t n, LightType type, uint64_t seed, bool coloured = false) {
   LightSet s;
@@ -37,24 +39,28 @@ LightSet randomLights(size_t n, LightType type, uint64_t seed, bool coloured = f
 }
 
 // Every node's box, cone and intensity must cover its children, and every light
-// must sit in exactly one leaf.
+// must sit in exactly one leaf. Inner nodes sit in preorder: a left inner child in the
+// next slot, a right one after the left subtree's inner nodes.
 void checkTree(const LightSet& set, const LightTree& t) {
   std::set<uint32_t> leaves;
-  std::function<void(uint32_t)> visit = [&](uint32_t i) {
-    const LightNode& n = t.nodes[i];
-    if (n.isLeaf()) {
-      EXPECT_EQ(n.lights, 1u);
+  uint32_t nextSlot = 0;
+  std::function<uint32_t(NodeRef)> visit = [&](NodeRef r) -> uint32_t {  // returns the light count
+    const LightNode n = t.node(set, r);
+    if (isLeafRef(r)) {
+      EXPECT_EQ(t.lightCount(r), 1u);
+      EXPECT_EQ(n.rep, leafLight(r));
       EXPECT_TRUE(leaves.insert(n.rep).second) << "light in two leaves";
       const Light& l = set.lights[n.rep];
       Vec3 p = l.type == LightType::Directional ? -l.direction : l.position;
       EXPECT_EQ(n.lo, p);
-      return;
+      return 1;
     }
-    const LightNode& a = t.nodes[n.left];
-    const LightNode& b = t.nodes[n.left + 1];
-    EXPECT_GT(n.left, i) << "children come after parents";
+    EXPECT_EQ(r, nextSlot++) << "inner nodes in preorder";
+    const NodeRef ra = n.left(r), rb = n.right(r);
+    const LightNode a = t.node(set, ra), b = t.node(set, rb);
     EXPECT_TRUE(n.rep == a.rep || n.rep == b.rep) << "representative comes from a child";
-    EXPECT_EQ(n.lights, a.lights + b.lights) << "light counts add up";
+    EXPECT_EQ(n.lights(), t.lightCount(ra) + t.lightCount(rb)) << "light counts add up";
+    EXPECT_EQ(n.leftLights(), t.lightCount(ra));
     for (int k = 0; k < 3; ++k) {
       EXPECT_LE(n.lo[k], std::min(a.lo[k], b.lo[k]));
       EXPECT_GE(n.hi[k], std::max(a.hi[k], b.hi[k]));
@@ -64,12 +70,15 @@ void checkTree(const LightSet& set, const LightTree& t) {
       const Light& la = set.lights[a.rep];
       EXPECT_GE(dot(la.direction, n.axis), n.cosHalfAngle - 1e-4f);
     }
-    visit(n.left);
-    visit(n.left + 1);
+    uint32_t count = visit(ra);
+    count += visit(rb);
+    EXPECT_EQ(count, n.lights());
+    return count;
   };
-  ASSERT_FALSE(t.nodes.empty());
-  visit(0);
-  EXPECT_EQ(t.nodes.size(), 2 * leaves.size() - 1);
+  ASSERT_FALSE(t.empty());
+  EXPECT_EQ(visit(t.root), t.lightTotal);
+  EXPECT_EQ(t.nodes.size(), leaves.size() - 1) << "inner nodes only";
+  EXPECT_EQ(leaves.size(), t.lightTotal);
 }
 
 class TreeBuild : public ::testing::TestWithParam<std::tuple<TreeBuilder, LightType>> {};
@@ -81,7 +90,7 @@ TEST_P(TreeBuild, IsAValidClusterHierarchy) {
     LightForest f = buildLightForest(set, TreeBuildOptions{builder, 5});
     ASSERT_EQ(f.trees.size(), 1u);
     checkTree(set, f.trees[0]);
-    ASSERT_EQ(f.trees[0].moments.size(), f.trees[0].nodes.size() / 2);  // inner nodes only
+    ASSERT_EQ(f.trees[0].moments.size(), f.trees[0].nodes.size());  // inner nodes only
     // Only the seed builder stores the seed's traversal data; others leave it to makeCourseCuts.
     ASSERT_EQ(f.trees[0].course.size(), builder == TreeBuilder::Course ? f.trees[0].nodes.size() : 0u);
   }
@@ -117,7 +126,8 @@ TEST_P(TreeBuild, IsDeterministic) {
   ASSERT_EQ(a.trees[0].nodes.size(), b.trees[0].nodes.size());
   for (size_t i = 0; i < a.trees[0].nodes.size(); ++i) {
     ASSERT_EQ(a.trees[0].nodes[i].rep, b.trees[0].nodes[i].rep);
-    ASSERT_EQ(a.trees[0].nodes[i].left, b.trees[0].nodes[i].left);
+    ASSERT_EQ(a.trees[0].nodes[i].a, b.trees[0].nodes[i].a);
+    ASSERT_EQ(a.trees[0].nodes[i].b, b.trees[0].nodes[i].b);
   }
 }
 
@@ -140,7 +150,7 @@ TEST(TreeBuild, SeparatesGroupsAndTypes) {
   LightForest f = buildLightForest(set);
   ASSERT_EQ(f.trees.size(), 3u);
   size_t total = 0;
-  for (const LightTree& t : f.trees) total += leafCount(t, 0);
+  for (const LightTree& t : f.trees) total += leafCount(t, t.root);
   EXPECT_EQ(total, 100u);
 }
 
@@ -148,7 +158,7 @@ TEST(TreeBuild, SkipsLightsWithoutIntensity) {
   LightSet set = randomLights(10, LightType::Omni, 1);
   set.lights[3].intensity = Color(0);
   LightForest f = buildLightForest(set);
-  EXPECT_EQ(leafCount(f.trees[0], 0), 9u);
+  EXPECT_EQ(leafCount(f.trees[0], f.trees[0].root), 9u);
 }
 
 // computeMoments as it was, serial: the reference for the parallel one.
@@ -158,21 +168,19 @@ std::vector<NodeMoments> serialMoments(const LightSet& lights, const LightTree& 
     Vec3d pos, axis, posU, axisU;
   };
   std::vector<NodeMoments> m(tree.nodes.size());
-  std::vector<std::pair<uint32_t, bool>> stack{{0u, false}};
+  std::vector<std::pair<NodeRef, bool>> stack{{tree.root, false}};
   std::vector<Sums> done;
   while (!stack.empty()) {
     auto [i, expanded] = stack.back();
     stack.pop_back();
-    const LightNode& n = tree.nodes[i];
-    if (n.isLeaf()) {
+    const LightNode n = tree.node(lights, i);
+    if (isLeafRef(i)) {
       const Light& l = lights.lights[n.rep];
-      m[i].centroid = l.type == LightType::Directional ? -l.direction : l.position;
-      m[i].meanAxis = l.direction;
       Sums s;
       s.w = 0.2126 * double(n.intensity.x) + 0.7152 * double(n.intensity.y) + 0.0722 * double(n.intensity.z);  // as computeMoments: in double
       s.n = 1;
-      s.posU = Vec3d(m[i].centroid);
-      s.axisU = Vec3d(m[i].meanAxis);
+      s.posU = Vec3d(l.type == LightType::Directional ? -l.direction : l.position);
+      s.axisU = Vec3d(l.direction);
       s.pos = s.posU * s.w;
       s.axis = s.axisU * s.w;
       done.push_back(s);
@@ -180,8 +188,8 @@ std::vector<NodeMoments> serialMoments(const LightSet& lights, const LightTree& 
     }
     if (!expanded) {
       stack.emplace_back(i, true);
-      stack.emplace_back(n.left + 1, false);
-      stack.emplace_back(n.left, false);
+      stack.emplace_back(n.right(i), false);
+      stack.emplace_back(n.left(i), false);
       continue;
     }
     Sums b = done.back();
@@ -200,9 +208,9 @@ std::vector<NodeMoments> serialMoments(const LightSet& lights, const LightTree& 
   return m;
 }
 
-// The agglomerative builder lays the tree out and numbers it in preorder in one pass, and
-// sums the moments in parallel, large subtrees side by side: the same values, bit for bit,
-// as the serial passes (computePreorder; computeMoments as it was).
+// The agglomerative builder lays the tree out in preorder, subtrees in parallel (checkTree),
+// and sums the moments in parallel, large subtrees side by side: the same values, bit for
+// bit, as the serial pass (computeMoments as it was).
 TEST(Agglomerative, ParallelLayoutAndMomentsEqualSerialPasses) {
   for (LightType type : {LightType::Omni, LightType::Oriented, LightType::Directional}) {
     LightSet set = randomLights(50000, type, 33, true);
@@ -213,15 +221,12 @@ TEST(Agglomerative, ParallelLayoutAndMomentsEqualSerialPasses) {
     LightForest f = buildLightForest(set, o);
     const LightTree& t = f.trees[0];
     checkTree(set, t);
-    LightTree again = t;
-    computePreorder(again);
     std::vector<NodeMoments> ref = serialMoments(set, t);
     ASSERT_EQ(t.nodes.size(), ref.size());
     for (uint32_t i = 0; i < t.nodes.size(); ++i) {
       const NodeMoments got = t.momentsOf(set, i);
       ASSERT_EQ(got.centroid, ref[i].centroid) << i;
       ASSERT_EQ(got.meanAxis, ref[i].meanAxis) << i;
-      ASSERT_EQ(t.preorder[i], again.preorder[i]) << i;
     }
   }
 }
@@ -239,8 +244,8 @@ TEST(Agglomerative, MergesNearbyLightsFirst) {
     }
   LightForest f = buildLightForest(set);
   const LightTree& t = f.trees[0];
-  EXPECT_EQ(leafCount(t, t.nodes[0].left), 8u);
-  EXPECT_EQ(leafCount(t, t.nodes[0].left + 1), 8u);
+  EXPECT_EQ(leafCount(t, rootLeft(t)), 8u);
+  EXPECT_EQ(leafCount(t, rootRight(t)), 8u);
 }
 
 // Larger sets are clustered bottom-up in Morton-ordered groups first (Gu et al. 2013): the
@@ -250,8 +255,7 @@ TEST(Agglomerative, MergesNearbyLightsFirst) {
 TEST(Agglomerative, BottomUpGroupsGiveAValidDeterministicTree) {
   auto cost = [](const LightTree& t) {
     double c = 0;
-    for (const LightNode& n : t.nodes)
-      if (!n.isLeaf()) c += double(luminance(n.intensity)) * double(length2(n.hi - n.lo));
+    for (const LightNode& n : t.nodes) c += double(luminance(n.intensity)) * double(length2(n.hi - n.lo));
     return c;
   };
   for (LightType type : {LightType::Omni, LightType::Oriented}) {
@@ -268,7 +272,8 @@ TEST(Agglomerative, BottomUpGroupsGiveAValidDeterministicTree) {
     ASSERT_EQ(a.trees[0].nodes.size(), b.trees[0].nodes.size());
     for (size_t i = 0; i < a.trees[0].nodes.size(); ++i) {
       ASSERT_EQ(a.trees[0].nodes[i].rep, b.trees[0].nodes[i].rep) << i;
-      ASSERT_EQ(a.trees[0].nodes[i].left, b.trees[0].nodes[i].left) << i;
+      ASSERT_EQ(a.trees[0].nodes[i].a, b.trees[0].nodes[i].a) << i;
+      ASSERT_EQ(a.trees[0].nodes[i].b, b.trees[0].nodes[i].b) << i;
     }
     LightForest exact = buildLightForest(set, TreeBuildOptions{TreeBuilder::Agglomerative, 5});
     EXPECT_LT(cost(a.trees[0]), 1.3 * cost(exact.trees[0])) << lightTypeName(type);
@@ -287,7 +292,7 @@ TEST(SeedBuild, SplitsAtTheLargestGap) {
   }
   LightForest f = buildLightForest(set, TreeBuildOptions{TreeBuilder::Course, 1});
   const LightTree& t = f.trees[0];
-  uint32_t a = leafCount(t, t.nodes[0].left), b = leafCount(t, t.nodes[0].left + 1);
+  uint32_t a = leafCount(t, rootLeft(t)), b = leafCount(t, rootRight(t));
   EXPECT_EQ(std::min(a, b), 5u);
   // The seed error of a node of coincident equal lights is zero; of spread lights positive.
   EXPECT_GT(t.course[0].error, 0.0f);
@@ -331,12 +336,13 @@ TEST(TreeBuild, HugeIntensitiesBuildQuicklyAndStayFinite) {
       LightForest f = result.get();
       ASSERT_EQ(f.trees.size(), 1u);
       const LightTree& t = f.trees[0];
-      EXPECT_EQ(t.nodes.size(), 2 * set.lights.size() - 1);
+      EXPECT_EQ(t.nodes.size(), set.lights.size() - 1);
       std::set<uint32_t> leaves;
-      for (const LightNode& n : t.nodes) {
+      for (NodeRef r : t.preorderNodes()) {
+        const LightNode n = t.node(set, r);
         EXPECT_TRUE(isFinite(n.intensity));
         EXPECT_TRUE(isFinite(n.lo) && isFinite(n.hi));
-        if (n.isLeaf()) {
+        if (isLeafRef(r)) {
           EXPECT_TRUE(leaves.insert(n.rep).second);
         }
       }
@@ -377,7 +383,6 @@ TEST(Precision, ChainOfTenMillionMergesKeepsTheClusterIntensity) {
     c = detail::mergeClusters(c, detail::leafCluster(l, i), int32_t(2 * i), int32_t(2 * i + 1), true, 7);
   LightNode node{};
   detail::setNodeFromCluster(node, c);
-  node.left = 1;  // an inner node
   for (int k = 0; k < 3; ++k) {
     const double want = double(bright[k]) + double(kDim) * double(dim[k]);
     EXPECT_NEAR(node.intensity[k], want, 1e-6 * want) << "channel " << k;
@@ -419,35 +424,29 @@ TEST(Precision, MomentsOfAMillionLevelChainAreExact) {
     s.lights[i].direction = Vec3(0, 0, 1);
     s.lights[i].intensity = Color(0.3f);
   }
-  // Node 2j (j < N-1) is inner: left child 2j+1 is light j's leaf, right child 2j+2 the rest.
+  // Inner node j (slot j, j < N-1): its left child is light j's leaf, its right child
+  // the rest (slot j + 1, or light N-1's leaf).
   LightTree t;
   t.type = LightType::Omni;
-  t.nodes.resize(2 * size_t(kN) - 1);
-  for (uint32_t j = 0; j < kN; ++j) {
-    LightNode& leaf = t.nodes[j + 1 < kN ? 2 * j + 1 : 2 * j];
-    leaf = LightNode{};
-    leaf.lo = leaf.hi = s.lights[j].position;
-    leaf.intensity = s.lights[j].intensity;
-    leaf.rep = j;
-    leaf.left = 0;
-    leaf.lights = 1;
-  }
+  t.lightTotal = kN;
+  t.root = 0;
+  t.nodes.resize(size_t(kN) - 1);
   for (uint32_t j = kN - 1; j-- > 0;) {
-    LightNode& n = t.nodes[2 * j];
+    LightNode& n = t.nodes[j];
     n = LightNode{};
     n.lo = Vec3(float(j) / float(kN), 1, 0);
     n.hi = Vec3(float(kN - 1) / float(kN), 1, 0);
     n.intensity = Color(float(0.3 * double(kN - j)));
     n.rep = j;
-    n.left = 2 * j + 1;
-    n.lights = kN - j;
+    const bool lastPair = j + 2 == kN;
+    n.setChildren(true, j, lastPair, kN - 1, kN - j);
   }
   computeMoments(s, t);
   for (uint32_t j : {0u, 1u, 1000u, kN / 2, kN - 10}) {
-    const NodeMoments m = t.momentsOf(s, 2 * j);
+    const NodeMoments m = t.momentsOf(s, j);
     const double want = (double(j) + double(kN - 1)) / (2.0 * kN);
     EXPECT_NEAR(m.centroid.x, want, 1e-6 * want) << "node of the suffix from light " << j;
-    EXPECT_EQ(t.lightCount(2 * j), kN - j);
+    EXPECT_EQ(t.lightCount(j), kN - j);
   }
 }
 

@@ -33,7 +33,8 @@ constexpr uint8_t kStateMask = 7;  // visibility and kFirstOrderBit
 // bytes in memory, each push read back what it had just written byte by byte, a
 // store-forwarding stall that was a fifth of the merge, perf on the church).
 struct Item {
-  uint32_t node;
+  NodeRef node;
+  uint32_t pre;  // its preorder position
   uint32_t state;
 };
 inline uint8_t stateOf(uint32_t state, int i) { return uint8_t(state >> (8 * i)); }
@@ -65,7 +66,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
     for (int j = i + 1; j < count; ++j) spread2 = std::max(spread2, length2(samples[i]->point - samples[j]->point));
   for (uint32_t t = 0; t < forest.trees.size(); ++t) {
     const LightTree& tree = forest.trees[t];
-    if (tree.nodes.empty()) continue;
+    if (tree.empty()) continue;
     // Each sample's entries of this tree are in preorder, and so is the walk: one cursor
     // per sample moves forward only.
     uint32_t cursor[kMaxSamples], end[kMaxSamples];
@@ -74,7 +75,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       end[i] = samples[i]->treeBegin[t + 1];
     }
     stack.clear();
-    Item it{0, 0xffffffffu};  // the root, kAbove for every sample
+    Item it{tree.root, 0, 0xffffffffu};  // the root, kAbove for every sample
     bool descending = true;   // `it` is the left child just reached, not yet on the stack
     for (;;) {
       if (!descending) {
@@ -85,8 +86,9 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       descending = false;
       // Bit i: sample i's cut holds this very node (its entry is the one before its cursor).
       uint32_t exact = 0;
-      const LightNode& n = tree.nodes[it.node];
-      const uint32_t pre = tree.preorder[it.node];
+      const bool leaf = isLeafRef(it.node);
+      const LightNode n = tree.node(lights, it.node);
+      const uint32_t pre = it.pre;
       bool above = false;
       for (int i = 0; i < count; ++i) {
         if (stateOf(it.state, i) != kAbove) continue;
@@ -98,7 +100,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
                                         (CutRecord::firstOrderOf(e[c]) ? kFirstOrderBit : 0)));
           exact |= 1u << i;
           ++c;
-        } else if (n.isLeaf() || c >= end[i]) {
+        } else if (leaf || c >= end[i]) {
           setState(it.state, i, uint8_t(CutVisibility::Untested));  // a record of another forest
         } else {
           above = true;
@@ -111,7 +113,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         // so, the coarser cut will do.
         const uint8_t vf = uint8_t(CutVisibility::Visible) | kFirstOrderBit;
         bool kept = false, ok = true;
-        const uint32_t last = pre + 2 * tree.lightCount(it.node) - 1;  // the subtree's preorder range
+        const uint32_t last = pre + 2 * n.lights() - 1;  // (`above`: an inner node)  // the subtree's preorder range
         uint32_t past[kMaxSamples];  // per refining sample: its first entry after the subtree
         for (int i = 0; i < count && ok; ++i) {
           if (stateOf(it.state, i) == kAbove) continue;
@@ -139,10 +141,11 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       }
       if (above) {
         // The children inherit states, not the entries (their `exact` starts at 0).
-        __builtin_prefetch(&tree.nodes[n.left]);
-        __builtin_prefetch(&tree.preorder[n.left]);
-        stack.push_back(Item{n.left + 1, it.state});
-        it.node = n.left;  // the left child next: the walk stays in preorder
+        const NodeRef left = n.left(it.node);
+        if (!isLeafRef(left)) __builtin_prefetch(&tree.nodes[left]);
+        stack.push_back(Item{n.right(it.node), n.rightPre(pre), it.state});
+        it.node = left;  // the left child next: the walk stays in preorder
+        it.pre = LightNode::leftPre(pre);
         descending = true;
         continue;
       }

@@ -41,7 +41,7 @@ enum class CutVisibility : uint8_t {
   Partial = 3,   // through glass: a colour between 0 and 1
 };
 
-// A sample's cut: per tree, its nodes in preorder (LightTree::preorder) with their
+// A sample's cut: per tree, its nodes in preorder (LightTree::preorderNodes) with their
 // CutVisibility and whether the node's first-order estimate was used (estimate.h), packed
 // as preorder << 3 | firstOrder << 2 | visibility.
 struct CutRecord {
@@ -83,7 +83,8 @@ struct MergedCut {
     // The first-order factor (CutRecord::factor) of the samples whose cut holds the node,
     // averaged, when every sample used first-order estimates there; else 1.
     float factor;
-    uint32_t tree, node;  // where it is in the forest
+    uint32_t tree;  // where it is in the forest
+    NodeRef node;
   };
   std::vector<Node> nodes;  // without the nodes every sample found occluded
   uint32_t occluded = 0;    // how many those were (they are in the cut, contributing 0)

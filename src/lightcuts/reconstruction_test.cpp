@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <set>
+
 #include <functional>
 
 #include "lightcuts/evaluator.h"
@@ -28,9 +31,16 @@ Color open(const Vec3&) { return Color(1); }
 Color halfBlocked(const Vec3& wi) { return wi.x < 0 ? Color(0) : Color(1); }
 Color allBlocked(const Vec3&) { return Color(0); }
 
-uint32_t subtreeSize(const LightTree& t, uint32_t i) {
+uint32_t subtreeSize(const LightTree& t, NodeRef i) {
+  if (isLeafRef(i)) return 1;
   const LightNode& n = t.nodes[i];
-  return n.isLeaf() ? 1 : 1 + subtreeSize(t, n.left) + subtreeSize(t, n.left + 1);
+  return 1 + subtreeSize(t, n.left(i)) + subtreeSize(t, n.right(i));
+}
+
+// The position of node r in LightTree::preorderNodes.
+uint32_t preorderOf(const LightTree& t, NodeRef r) {
+  const std::vector<NodeRef> all = t.preorderNodes();
+  return uint32_t(std::find(all.begin(), all.end(), r) - all.begin());
 }
 
 struct Fixture {
@@ -59,17 +69,22 @@ TEST(Reconstruction, PreorderMakesEverySubtreeAContiguousRange) {
   Fixture f;
   ASSERT_EQ(f.forest.trees.size(), 1u);
   const LightTree& t = f.forest.trees[0];
-  ASSERT_EQ(t.preorder.size(), t.nodes.size());
-  std::vector<int> seen(t.nodes.size(), 0);
-  for (uint32_t i = 0; i < t.nodes.size(); ++i) {
-    ASSERT_LT(t.preorder[i], t.nodes.size());
-    ++seen[t.preorder[i]];
-    const LightNode& n = t.nodes[i];
-    if (n.isLeaf()) continue;
-    EXPECT_EQ(t.preorder[n.left], t.preorder[i] + 1);
-    EXPECT_EQ(t.preorder[n.left + 1], t.preorder[i] + 1 + subtreeSize(t, n.left));
+  // The walks carry a node's preorder position down (LightNode::leftPre, rightPre): they
+  // must agree with a plain depth-first walk's, and each subtree spans 2 count - 1.
+  const std::vector<NodeRef> all = t.preorderNodes();
+  ASSERT_EQ(all.size(), 2 * size_t(t.lightTotal) - 1);
+  std::set<NodeRef> seen(all.begin(), all.end());
+  EXPECT_EQ(seen.size(), all.size());
+  for (uint32_t p = 0; p < all.size(); ++p) {
+    const NodeRef r = all[p];
+    EXPECT_EQ(subtreeSize(t, r), 2 * t.lightCount(r) - 1);
+    if (isLeafRef(r)) continue;
+    const LightNode& n = t.nodes[r];
+    ASSERT_LT(n.rightPre(p), all.size());
+    EXPECT_EQ(all[LightNode::leftPre(p)], n.left(r));
+    EXPECT_EQ(all[n.rightPre(p)], n.right(r));
+    EXPECT_EQ(n.rightPre(p), p + 1 + subtreeSize(t, n.left(r)));
   }
-  for (int c : seen) EXPECT_EQ(c, 1);
 }
 
 TEST(Reconstruction, RecordedCutIsThePartitionTheLightcutUsed) {
@@ -82,11 +97,10 @@ TEST(Reconstruction, RecordedCutIsThePartitionTheLightcutUsed) {
   for (size_t i = 1; i < r.entries.size(); ++i) EXPECT_LT(CutRecord::preorderOf(r.entries[i - 1]), CutRecord::preorderOf(r.entries[i]));
   // Disjoint subtrees (each starts past the previous one's range) covering every leaf.
   const LightTree& t = f.forest.trees[0];
-  std::vector<uint32_t> byPre(t.nodes.size());
-  for (uint32_t i = 0; i < t.nodes.size(); ++i) byPre[t.preorder[i]] = i;
+  const std::vector<NodeRef> byPre = t.preorderNodes();
   uint32_t next = 0, leaves = 0;
   for (uint32_t e : r.entries) {
-    uint32_t node = byPre[CutRecord::preorderOf(e)];
+    NodeRef node = byPre[CutRecord::preorderOf(e)];
     EXPECT_GE(CutRecord::preorderOf(e), next) << "overlapping subtrees";
     next = CutRecord::preorderOf(e) + subtreeSize(t, node);
     leaves += test_lights::leafCount(t, node);
@@ -120,17 +134,16 @@ TEST(Reconstruction, LargeRecordedCutIsInPreorderPerTree) {
   size_t leavesTotal = 0;
   for (uint32_t t = 0; t < 2; ++t) {
     const LightTree& tree = forest.trees[t];
-    std::vector<uint32_t> byPre(tree.nodes.size());
-    for (uint32_t i = 0; i < tree.nodes.size(); ++i) byPre[tree.preorder[i]] = i;
+    const std::vector<NodeRef> byPre = tree.preorderNodes();
     uint32_t next = 0, leaves = 0;
     for (uint32_t k = r.treeBegin[t]; k < r.treeBegin[t + 1]; ++k) {
       const uint32_t pre = CutRecord::preorderOf(r.entries[k]);
-      ASSERT_LT(pre, tree.nodes.size());
+      ASSERT_LT(pre, byPre.size());
       EXPECT_GE(pre, next) << "tree " << t << ": out of order or overlapping at entry " << k;
       next = pre + subtreeSize(tree, byPre[pre]);
       leaves += test_lights::leafCount(tree, byPre[pre]);
     }
-    EXPECT_EQ(leaves, tree.lightCount(0)) << "tree " << t;
+    EXPECT_EQ(leaves, tree.lightCount(tree.root)) << "tree " << t;
     leavesTotal += leaves;
   }
   EXPECT_EQ(leavesTotal, lights.lights.size());
@@ -241,7 +254,7 @@ TEST(Reconstruction, MergedCutIsAPartitionAccurateAtEverySample) {
   // Still a partition of the lights: the intensities add up to the root's.
   Color sum(0);
   for (const MergedCut::Node& n : m.nodes) sum += n.intensity;
-  Color root = f.forest.trees[0].nodes[0].intensity;
+  Color root = f.forest.trees[0].nodes[f.forest.trees[0].root].intensity;
   EXPECT_NEAR(sum.x, root.x, 1e-3f * root.x);
   EXPECT_NEAR(sum.z, root.z, 1e-3f * root.z);
   // Evaluated at each sample, the merged cut keeps the lightcut's accuracy.
@@ -271,7 +284,8 @@ TEST(Reconstruction, AgreeingSmoothVisibleSamplesKeepTheCoarserCut) {
   LightForest forest = buildLightForest(lights);
   auto lc = makeLightcuts(lights, forest, CutOptions{});
   const LightTree& t = forest.trees[0];
-  const uint32_t l = t.nodes[0].left, r = l + 1;
+  const NodeRef l = t.nodes[0].left(0), r = t.nodes[0].right(0);
+  const uint32_t preL = preorderOf(t, l), preR = preorderOf(t, r);
   auto rec = [&](std::vector<uint32_t> entries, std::vector<float> factors) {
     CutRecord c;
     c.valid = true;
@@ -281,12 +295,12 @@ TEST(Reconstruction, AgreeingSmoothVisibleSamplesKeepTheCoarserCut) {
     return c;
   };
   const CutVisibility V = CutVisibility::Visible, O = CutVisibility::Occluded;
-  CutRecord b = rec({CutRecord::pack(t.preorder[0], V, true)}, {0.9f});
+  CutRecord b = rec({CutRecord::pack(0, V, true)}, {0.9f});
   MergedCut m;
 
   // Both visible with first-order estimates: the root alone, without a ray, with the
   // first-order factor of the sample that kept it.
-  CutRecord a = rec({CutRecord::pack(t.preorder[l], V, true), CutRecord::pack(t.preorder[r], V, true)}, {1.1f, 1.2f});
+  CutRecord a = rec({CutRecord::pack(preL, V, true), CutRecord::pack(preR, V, true)}, {1.1f, 1.2f});
   const CutRecord* ab[2] = {&a, &b};
   lc->mergeSamples(ab, 2, m);
   ASSERT_EQ(m.nodes.size(), 1u);
@@ -296,7 +310,7 @@ TEST(Reconstruction, AgreeingSmoothVisibleSamplesKeepTheCoarserCut) {
 
   // A saw part of it hidden: A's finer cut, with a ray where the samples disagree; the
   // visible child keeps A's factor (B holds only its parent).
-  CutRecord a2 = rec({CutRecord::pack(t.preorder[l], O, false), CutRecord::pack(t.preorder[r], V, true)}, {1, 1.2f});
+  CutRecord a2 = rec({CutRecord::pack(preL, O, false), CutRecord::pack(preR, V, true)}, {1, 1.2f});
   const CutRecord* a2b[2] = {&a2, &b};
   lc->mergeSamples(a2b, 2, m);
   ASSERT_EQ(m.nodes.size(), 2u);
@@ -309,7 +323,7 @@ TEST(Reconstruction, AgreeingSmoothVisibleSamplesKeepTheCoarserCut) {
 
   // B's root estimate was not first-order (not smooth there): the finer cut again, with
   // no first-order factor.
-  CutRecord b2 = rec({CutRecord::pack(t.preorder[0], V, false)}, {1});
+  CutRecord b2 = rec({CutRecord::pack(0, V, false)}, {1});
   const CutRecord* ab2[2] = {&a, &b2};
   lc->mergeSamples(ab2, 2, m);
   ASSERT_EQ(m.nodes.size(), 2u);

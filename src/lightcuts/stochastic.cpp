@@ -49,16 +49,17 @@ class StochasticLightcuts final : public LightEvaluator {
     heap.clear();
     done.clear();
     const BoundFrames frames(sp);
-    auto bound = [&](uint32_t t, uint32_t ni) {
+    auto bound = [&](uint32_t t, NodeRef ni) {
       const LightTree& tree = forest_.trees[t];
       ++stats.boundsEvaluated;
-      return luminance(clusterBounds(tree.nodes[ni], tree.type, tree.bound, sp, frames, nullptr));
+      return luminance(clusterBounds(tree.node(lights_, ni), tree.type, tree.bound, sp, frames, nullptr));
     };
     // The cut: refine the cluster of the largest bound until the cut has the size asked for.
     for (uint32_t t = 0; t < forest_.trees.size(); ++t) {
-      if (forest_.trees[t].nodes.empty()) continue;
-      float b = bound(t, 0);
-      if (b > 0) heap.push_back({b, t, 0});
+      if (forest_.trees[t].empty()) continue;
+      const NodeRef root = forest_.trees[t].root;
+      float b = bound(t, root);
+      if (b > 0) heap.push_back({b, t, root});
     }
     std::make_heap(heap.begin(), heap.end());
     const size_t target = size_t(std::max(1, opt_.stochasticCut));
@@ -66,15 +67,15 @@ class StochasticLightcuts final : public LightEvaluator {
       std::pop_heap(heap.begin(), heap.end());
       Entry e = heap.back();
       heap.pop_back();
-      const LightNode& n = forest_.trees[e.tree].nodes[e.node];
-      if (n.isLeaf()) {
+      if (isLeafRef(e.node)) {
         done.push_back(e);
         continue;
       }
-      for (uint32_t k = 0; k < 2; ++k) {
-        float b = bound(e.tree, n.left + k);
+      const LightNode& n = forest_.trees[e.tree].nodes[e.node];
+      for (NodeRef c : {n.left(e.node), n.right(e.node)}) {
+        float b = bound(e.tree, c);
         if (b > 0) {
-          heap.push_back({b, e.tree, n.left + k});
+          heap.push_back({b, e.tree, c});
           std::push_heap(heap.begin(), heap.end());
         }
       }
@@ -86,11 +87,11 @@ class StochasticLightcuts final : public LightEvaluator {
     Vec3d total;
     for (const Entry& e : done) {
       const LightTree& tree = forest_.trees[e.tree];
-      uint32_t ni = e.node;
+      NodeRef ni = e.node;
       double p = 1;
-      while (!tree.nodes[ni].isLeaf()) {
-        const uint32_t left = tree.nodes[ni].left;
-        const float a = bound(e.tree, left), b = bound(e.tree, left + 1);
+      while (!isLeafRef(ni)) {
+        const NodeRef left = tree.nodes[ni].left(ni), right = tree.nodes[ni].right(ni);
+        const float a = bound(e.tree, left), b = bound(e.tree, right);
         if (!(a + b > 0)) {
           p = 0;
           break;
@@ -98,10 +99,10 @@ class StochasticLightcuts final : public LightEvaluator {
         const double pa = double(a) / (double(a) + double(b));
         const bool goLeft = rng.uniformDouble() < pa;
         p *= goLeft ? pa : 1 - pa;
-        ni = goLeft ? left : left + 1;
+        ni = goLeft ? left : right;
       }
       if (!(p > 0)) continue;
-      const Light& l = lights_.lights[tree.nodes[ni].rep];
+      const Light& l = lights_.lights[leafLight(ni)];
       Color mg;
       Vec3 wi;
       float dist;

@@ -154,8 +154,11 @@ TEST(Determinism, LightcutsImageIsTheSameAtOneAndTwoThreads) {
   lightcuts::LightForest again = lightcuts::buildLightForest(l.scene->lights());
   ASSERT_EQ(again.nodeCount(), forest.nodeCount());
   for (size_t t = 0; t < forest.trees.size(); ++t)
-    for (size_t i = 0; i < forest.trees[t].nodes.size(); ++i)
+    for (size_t i = 0; i < forest.trees[t].nodes.size(); ++i) {
       ASSERT_EQ(forest.trees[t].nodes[i].rep, again.trees[t].nodes[i].rep);
+      ASSERT_EQ(forest.trees[t].nodes[i].a, again.trees[t].nodes[i].a);
+      ASSERT_EQ(forest.trees[t].nodes[i].b, again.trees[t].nodes[i].b);
+    }
 }
 
 }  // namespace
