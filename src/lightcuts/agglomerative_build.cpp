@@ -29,6 +29,10 @@
 #include <queue>
 #include <unordered_map>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
 #include "lightcuts/cluster.h"
 
 namespace lc::lightcuts {
@@ -38,11 +42,13 @@ namespace {
 using detail::Cluster;
 
 // The clusters of one build by id: leaves (0..n-1) made from their lights when asked, so
-// that only the n - 1 merges (n..2n-2) take memory (88 bytes each).
+// that only the n - 1 merges (n..2n-2) take memory (88 bytes each). The merges are left
+// unwritten when allocated (BigVector): each is written by the worker that makes it, so
+// their pages are first touched in parallel, not zeroed by one thread beforehand.
 struct ClusterStore {
   const LightSet& lights;
   const std::vector<uint32_t>& indices;
-  std::vector<Cluster> merged;  // id n + k at k
+  BigVector<Cluster> merged;  // id n + k at k
   double weightScale = 1;       // leaf weights: luminance over the brightest light's
 
   size_t leaves() const { return indices.size(); }
@@ -423,9 +429,14 @@ struct LayoutItem {
 
 class TreeWriter {
  public:
-  TreeWriter(const ClusterStore& clusters, LightTree& tree) : cl_(clusters), tree_(tree) {}
+  TreeWriter(ClusterStore& clusters, LightTree& tree) : cl_(clusters), tree_(tree) {}
 
-  void run(int32_t root) {
+  // `chunkBegin`: the first merge id of each bottom-up chunk, then the first of the exact
+  // top's (empty when the whole tree was clustered exactly). The subtrees under the top's
+  // merges are laid out chunk after chunk, and each chunk's merges are given back to the
+  // system as soon as its subtrees are written: the build's peak is lights + merges +
+  // nodes, and at 10M VPL paths the merges are 715 MB of it.
+  void run(int32_t root, const std::vector<int32_t>& chunkBegin = {}) {
     tree_.lightTotal = uint32_t(cl_.leaves());
     if (size_t(root) < cl_.leaves()) {
       tree_.root = leafRef(cl_.indices[size_t(root)]);
@@ -433,27 +444,42 @@ class TreeWriter {
     }
     tree_.root = 0;
     tree_.nodes.resize(cl_.leaves() - 1);  // unwritten: every node is written below
-    // Top levels serially, down to subtrees of at most kTask lights; those in parallel.
+    // Chunk by chunk, the nodes of a chunk are scattered over the array: on huge pages the
+    // first chunk alone would fault in all of it while no merge is given back yet.
+    if (!chunkBegin.empty()) smallPagesWhileFilling(tree_.nodes);
+    // Top levels serially: the exact top's merges or, for a tree clustered exactly, down to
+    // subtrees of at most kTask lights. Those subtrees are written in parallel.
     constexpr uint32_t kTask = 1u << 14;
+    const bool chunked = !chunkBegin.empty();
     std::vector<LayoutItem> tasks;
     std::vector<LayoutItem> stack{{root, 0}};
     while (!stack.empty()) {
       LayoutItem it = stack.back();
       stack.pop_back();
-      if (cl_.count(it.cluster) <= kTask) {
+      if (chunked ? it.cluster < chunkBegin.back() : cl_.count(it.cluster) <= kTask) {
         tasks.push_back(it);
         continue;
       }
       write(it, stack);
     }
-    tbb::parallel_for(size_t(0), tasks.size(), [&](size_t k) {
-      std::vector<LayoutItem> st{tasks[k]};
-      while (!st.empty()) {
-        LayoutItem it = st.back();
-        st.pop_back();
-        write(it, st);
-      }
-    });
+    // Chunk by chunk (a chunk's merges have the ids from its chunkBegin to the next one's).
+    std::stable_sort(tasks.begin(), tasks.end(), [](const LayoutItem& a, const LayoutItem& b) { return a.cluster < b.cluster; });
+    size_t from = 0;
+    for (size_t c = 0; c + 1 < std::max<size_t>(chunkBegin.size(), 2); ++c) {
+      size_t to = from;
+      while (to < tasks.size() && (!chunked || tasks[to].cluster < chunkBegin[c + 1])) ++to;
+      tbb::parallel_for(size_t(from), to, [&](size_t k) {
+        std::vector<LayoutItem> st{tasks[k]};
+        while (!st.empty()) {
+          LayoutItem it = st.back();
+          st.pop_back();
+          write(it, st);
+        }
+      });
+      if (chunked) release(chunkBegin[c], chunkBegin[c + 1]);
+      from = to;
+    }
+    if (chunked) hugePagesAgain(tree_.nodes);
   }
 
  private:
@@ -470,7 +496,22 @@ class TreeWriter {
     if (!leftLeaf) stack.push_back(LayoutItem{c.left, it.slot + 1});
   }
 
-  const ClusterStore& cl_;
+  // Gives the pages of merges [a, b) back to the system (nothing reads them again; the
+  // pages at either end may hold other merges and stay).
+  void release(int32_t a, int32_t b) const {
+#if defined(__linux__) && defined(MADV_DONTNEED)
+    constexpr uintptr_t kPage = 4096;
+    const uintptr_t lo = reinterpret_cast<uintptr_t>(cl_.merged.data() + (size_t(a) - cl_.leaves()));
+    const uintptr_t hi = reinterpret_cast<uintptr_t>(cl_.merged.data() + (size_t(b) - cl_.leaves()));
+    const uintptr_t first = (lo + kPage - 1) / kPage * kPage, last = hi / kPage * kPage;
+    if (first < last) madvise(reinterpret_cast<void*>(first), last - first, MADV_DONTNEED);
+#else
+    (void)a;
+    (void)b;
+#endif
+  }
+
+  ClusterStore& cl_;
   LightTree& tree_;
 };
 
@@ -773,7 +814,7 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   size_t n = indices.size();
   bool withCone = (type == LightType::Oriented || type == LightType::Spot) && coneWeight > 0;
   // Ids: leaves 0..n-1, merges n..2n-2, handed out in fixed blocks.
-  ClusterStore clusters{lights, indices, std::vector<Cluster>(n - 1)};
+  ClusterStore clusters{lights, indices, BigVector<Cluster>(n - 1)};
   // Weights relative to the brightest light (luminance in double): the metric's sums and
   // products stay finite whatever the power. Lights of 1e38 would otherwise give inf (or
   // NaN from inf * 0) metrics, and the nearest-neighbour search never found a partner.
@@ -789,6 +830,7 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
   }
 
   std::vector<int32_t> top;
+  std::vector<int32_t> chunkBegin;  // bottom-up: each chunk's first merge id, then the top's
   int32_t nextId = int32_t(n);
   if (n <= exactLimit) {
     for (size_t i = 0; i < n; ++i) top.push_back(int32_t(i));
@@ -807,7 +849,8 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
     while (chunk < n && (n + chunk - 1) / chunk * ApproximateClustering::survivors(chunk) > exactLimit / 2) chunk *= 2;
     size_t chunks = (n + chunk - 1) / chunk;
     std::vector<std::vector<int32_t>> survivors(chunks);
-    std::vector<int32_t> idBase(chunks);
+    std::vector<int32_t>& idBase = chunkBegin;
+    idBase.resize(chunks);
     for (size_t c = 0; c < chunks; ++c) {
       size_t size = std::min(chunk, n - c * chunk);
       idBase[c] = nextId;
@@ -820,15 +863,16 @@ LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint3
       if (progress) progress->add(kChunkShare * double(end - begin));
     });
     for (const auto& s : survivors) top.insert(top.end(), s.begin(), s.end());
+    chunkBegin.push_back(nextId);  // the exact top's merges
   }
   std::vector<Cluster> created;
   AgglomerativeBuilder builder(withCone, coneWeight, seed);
   std::vector<int32_t> root = builder.reduce(clusters, top, 1, nextId, created, true);
   std::copy(created.begin(), created.end(), clusters.merged.begin() + (nextId - int32_t(n)));
-  TreeWriter(clusters, tree).run(root[0]);
+  TreeWriter(clusters, tree).run(root[0], chunkBegin);
   // The clusters go before the moments come: the build's peak is nodes and merges, or
   // nodes and moments, never all three.
-  std::vector<Cluster>().swap(clusters.merged);
+  BigVector<Cluster>().swap(clusters.merged);
   computeMoments(lights, tree);
   if (progress) progress->add(n <= exactLimit ? double(n) : (1 - kChunkShare) * double(n));
   return tree;
