@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <unordered_map>
 #include <vector>
 
 #include "core/rng.h"
@@ -113,6 +114,28 @@ void layoutTree(const Get& get, int32_t root, LightTree& tree) {
     if (l.left >= 0) stack.push_back(c.left);  // next: a left child's slot follows its parent's
   }
 }
+
+// Luminance-weighted and plain sums of a subtree's positions and axes, in double: what a
+// node's moments are made from (computeMoments). A node's sums are its left child's plus
+// its right child's, whichever pass computes them, so every pass gives the same moments.
+struct MomentSums {
+  double w = 0, n = 0;
+  Vec3d pos, axis;    // sum of w x, sum of w n
+  Vec3d posU, axisU;  // unweighted sums
+  void add(const MomentSums& b) {
+    w += b.w;
+    n += b.n;
+    pos += b.pos;
+    axis += b.axis;
+    posU += b.posU;
+    axisU += b.axisU;
+  }
+};
+
+// Fills the moments of the inner nodes under `top` (their nodes written, tree.moments
+// sized) and returns the subtree's sums; `known` may supply some subtrees' sums.
+MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, NodeRef top,
+                          const std::unordered_map<NodeRef, MomentSums>* known = nullptr);
 
 inline void layoutTree(const std::vector<Cluster>& clusters, int32_t root, LightTree& tree) {
   layoutTree([&](int32_t id) -> const Cluster& { return clusters[size_t(id)]; }, root, tree);

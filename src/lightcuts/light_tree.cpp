@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "core/error.h"
+#include "lightcuts/cluster.h"
 
 namespace lc::lightcuts {
 
@@ -137,20 +138,7 @@ double lum(const Color& c) { return luminance(Vec3d(c)); }
 
 namespace {
 
-// Luminance-weighted and plain sums of a subtree's positions and axes, in double.
-struct MomentSums {
-  double w = 0, n = 0;
-  Vec3d pos, axis;    // sum of w x, sum of w n
-  Vec3d posU, axisU;  // unweighted sums
-  void add(const MomentSums& b) {
-    w += b.w;
-    n += b.n;
-    pos += b.pos;
-    axis += b.axis;
-    posU += b.posU;
-    axisU += b.axisU;
-  }
-};
+using detail::MomentSums;
 
 void setMeans(NodeMoments& m, const MomentSums& s) {
   if (s.w > 0) {
@@ -162,20 +150,25 @@ void setMeans(NodeMoments& m, const MomentSums& s) {
   }
 }
 
-// Post-order walk with an explicit stack (chains of merges can be deep): fills the moments
-// below `top` and returns top's sums. `known(r, sums)` may supply a subtree's sums.
-template <class Known>
-MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, NodeRef top, const Known& known) {
+}  // namespace
+
+namespace detail {
+
+MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, NodeRef top,
+                          const std::unordered_map<NodeRef, MomentSums>* known) {
+  // Post-order with an explicit stack (chains of merges can be deep).
   BigVector<NodeMoments>& m = tree.moments;
   std::vector<std::pair<NodeRef, bool>> stack{{top, false}};  // node, children done
   std::vector<MomentSums> done;  // the finished subtrees whose parent is not
   while (!stack.empty()) {
     auto [r, expanded] = stack.back();
     stack.pop_back();
-    MomentSums ks;
-    if (!expanded && known(r, ks)) {
-      done.push_back(ks);
-      continue;
+    if (!expanded && known) {
+      auto k = known->find(r);
+      if (k != known->end()) {
+        done.push_back(k->second);
+        continue;
+      }
     }
     if (isLeafRef(r)) {
       const Light& l = lights.lights[leafLight(r)];
@@ -205,7 +198,7 @@ MomentSums subtreeMoments(const LightSet& lights, LightTree& tree, NodeRef top, 
   return done.back();
 }
 
-}  // namespace
+}  // namespace detail
 
 void computeMoments(const LightSet& lights, LightTree& tree) {
   // The luminance-weighted sums of each subtree's positions and axes, in double, divided
@@ -220,13 +213,11 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
   // Top levels: split down to subtrees of at most kTask lights.
   constexpr uint32_t kTask = 1u << 14;
   std::vector<NodeRef> tasks;
-  std::unordered_map<NodeRef, uint32_t> taskOf;  // node -> task
   std::vector<NodeRef> stack{tree.root};
   while (!stack.empty()) {
     NodeRef r = stack.back();
     stack.pop_back();
     if (tree.lightCount(r) <= kTask) {
-      taskOf.emplace(r, uint32_t(tasks.size()));
       tasks.push_back(r);
       continue;
     }
@@ -234,16 +225,12 @@ void computeMoments(const LightSet& lights, LightTree& tree) {
     stack.push_back(n.right(r));
     stack.push_back(n.left(r));
   }
-  std::vector<MomentSums> sums(tasks.size());
-  auto none = [](NodeRef, MomentSums&) { return false; };
+  std::vector<detail::MomentSums> sums(tasks.size());
   tbb::parallel_for(size_t(0), tasks.size(),
-                    [&](size_t k) { sums[k] = subtreeMoments(lights, tree, tasks[k], none); });
-  subtreeMoments(lights, tree, tree.root, [&](NodeRef r, MomentSums& s) {
-    auto t = taskOf.find(r);
-    if (t == taskOf.end()) return false;
-    s = sums[t->second];
-    return true;
-  });
+                    [&](size_t k) { sums[k] = detail::subtreeMoments(lights, tree, tasks[k]); });
+  std::unordered_map<NodeRef, detail::MomentSums> known;
+  for (size_t k = 0; k < tasks.size(); ++k) known.emplace(tasks[k], sums[k]);
+  detail::subtreeMoments(lights, tree, tree.root, &known);
 }
 
 void computeCourseData(const LightSet& lights, LightTree& tree) {
@@ -377,9 +364,8 @@ LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& opt
     mixed.insert(mixed.end(), it->second.begin(), it->second.end());
     it = groups.erase(it);
   }
-  for (auto& [k, v] : groups)
-    if (v.size() > kMaxTreeLights)
-      throw Error("more than " + std::to_string(kMaxTreeLights) + " lights of one kind: a light tree holds at most that many");
+  if (lights.lights.size() > kMaxTreeLights)
+    throw Error("more than " + std::to_string(kMaxTreeLights) + " lights: a light tree names its lights in 30 bits");
   LightForest forest;
   forest.trees.resize(groups.size());
   std::vector<std::pair<GroupKey, const std::vector<uint32_t>*>> work;

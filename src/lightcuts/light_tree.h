@@ -1,10 +1,11 @@
 // Light trees: binary trees of light clusters. Each inner node stores what the Lightcuts
 // error bounds need (bounding box, cone of light normals, summed intensity, a
 // representative light) and, in a parallel array, the first moments that the first-order
-// estimate needs; a leaf is its light, stored nowhere else (NodeRef). Nodes sit in preorder,
-// so walks that need a node's preorder position (reconstruction cuts) carry it down. What the seed's traversal needs
-// (intensity-weighted centroid and direction, and its error radius) the seed builder
-// stores; for other trees the seed's evaluator computes it when it is made.
+// estimate needs; a leaf is its light, stored nowhere else (NodeRef). Inner nodes sit in
+// preorder, and walks that need a node's preorder position (reconstruction cuts) carry it
+// down. What the seed's traversal needs (intensity-weighted centroid and direction, and its
+// error radius) the seed builder stores; for other trees the seed's evaluator computes it
+// when it is made.
 //
 // Two builders:
 //   Agglomerative (Walter et al. 2005, built the fast way of Walter et al. 2008): greedily
@@ -82,7 +83,8 @@ inline Color leafIntensity(const Light& l) {
   return vmin(l.intensity, Color(std::numeric_limits<float>::max()));
 }
 
-// Light indices and light counts fit LightNode's 30-bit fields.
+// Light indices and light counts fit LightNode's 30-bit fields: buildLightForest refuses a
+// light set of more lights (40 GB of them).
 constexpr size_t kMaxTreeLights = LightNode::kValue;
 
 // Per-node data of the seed's traversal: a synthetic light at the intensity-weighted
@@ -218,7 +220,8 @@ LightTree buildCourseTree(const LightSet& lights, const std::vector<uint32_t>& i
 // it too narrow (buildLightForest calls it; the builders leave these trees without cones).
 void computeDirectionCones(const LightSet& lights, LightTree& tree);
 
-// Fills LightTree::moments from the finished nodes (buildLightForest calls it).
+// Fills LightTree::moments from the finished nodes (the seed builder's trees; the
+// agglomerative builder sums them as it lays the tree out, to the same values).
 void computeMoments(const LightSet& lights, LightTree& tree);
 
 // Fills LightTree::course from the finished nodes and their moments (centroids, mean
