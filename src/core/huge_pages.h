@@ -71,29 +71,21 @@ struct HugePageAllocator {
 template <class T>
 using BigVector = std::vector<T, HugePageAllocator<T>>;
 
-// For a BigVector about to be filled in scattered order while other large memory is being
-// given back (the light tree's layout): its pages fault in 4 KiB at a time as written, so
-// memory grows with what is written rather than by 2 MiB at each first touch. Advice only.
-// (Collapsing them back synchronously, MADV_COLLAPSE, cost 1.7 s per 512 MB here, more than
-// the huge pages save; afterwards the range is marked for khugepaged again.)
+// Switches a BigVector's block between huge and 4 KiB pages (advice only). The light tree's
+// layout fills its arrays in scattered order while it gives other large memory back: on
+// 4 KiB pages memory grows with what is written rather than by 2 MiB at each first touch;
+// afterwards the block is marked for huge pages again, for khugepaged. (Collapsing it back
+// at once, MADV_COLLAPSE, cost 1.7 s per 512 MB here, more than huge pages save.)
 template <class T>
-void smallPagesWhileFilling(BigVector<T>& v) {
-#if defined(__linux__) && defined(MADV_NOHUGEPAGE)
+void useHugePages(BigVector<T>& v, bool on) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE) && defined(MADV_NOHUGEPAGE)
+  constexpr size_t kPage = HugePageAllocator<T>::kHugePage;
   const size_t bytes = v.capacity() * sizeof(T);
   if (bytes >= HugePageAllocator<T>::kThreshold)
-    madvise(v.data(), (bytes + HugePageAllocator<T>::kHugePage - 1) / HugePageAllocator<T>::kHugePage * HugePageAllocator<T>::kHugePage, MADV_NOHUGEPAGE);
+    madvise(v.data(), (bytes + kPage - 1) / kPage * kPage, on ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
 #else
   (void)v;
-#endif
-}
-template <class T>
-void hugePagesAgain(BigVector<T>& v) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  const size_t bytes = v.capacity() * sizeof(T);
-  if (bytes >= HugePageAllocator<T>::kThreshold)
-    madvise(v.data(), (bytes + HugePageAllocator<T>::kHugePage - 1) / HugePageAllocator<T>::kHugePage * HugePageAllocator<T>::kHugePage, MADV_HUGEPAGE);
-#else
-  (void)v;
+  (void)on;
 #endif
 }
 

@@ -450,8 +450,8 @@ class TreeWriter {
     // Chunk by chunk, the nodes of a chunk are scattered over the array: on huge pages the
     // first chunk alone would fault in all of it while no merge is given back yet.
     if (!chunkBegin.empty()) {
-      smallPagesWhileFilling(tree_.nodes);
-      smallPagesWhileFilling(tree_.moments);
+      useHugePages(tree_.nodes, false);
+      useHugePages(tree_.moments, false);
     }
     // Top levels serially: the exact top's merges or, for a tree clustered exactly, down to
     // subtrees of at most kTask lights. Those subtrees are written in parallel.
@@ -492,8 +492,8 @@ class TreeWriter {
     for (size_t k = 0; k < tasks.size(); ++k) known.emplace(tasks[k].slot, sums[k]);
     detail::subtreeMoments(cl_.lights, tree_, 0, &known);
     if (chunked) {
-      hugePagesAgain(tree_.nodes);
-      hugePagesAgain(tree_.moments);
+      useHugePages(tree_.nodes, true);
+      useHugePages(tree_.moments, true);
     }
   }
 
