@@ -43,22 +43,9 @@ float widenedCos(double angle) {
 }
 }  // namespace
 
-LightNode LightTree::leafNode(const Light& l, uint32_t index) const {
-  LightNode n;
-  n.lo = n.hi = l.type == LightType::Directional ? -l.direction : l.position;
-  if (type == LightType::Directional) {
-    n.axis = unitd(Vec3d(l.direction)).toFloat();
-    n.cosHalfAngle = widenedCos(0);
-  } else if (l.type == LightType::Oriented || l.type == LightType::Spot) {
-    n.axis = l.direction;
-    n.cosHalfAngle = 1;
-  } else {
-    n.axis = Vec3(0, 0, 1);
-    n.cosHalfAngle = -1;
-  }
-  n.intensity = leafIntensity(l);
-  n.rep = index;
-  return n;
+void LightTree::directionalLeafCone(const Light& l, LightNode& n) {
+  n.axis = unitd(Vec3d(l.direction)).toFloat();
+  n.cosHalfAngle = widenedCos(0);
 }
 
 std::vector<NodeRef> LightTree::preorderNodes() const {

@@ -130,7 +130,23 @@ struct LightTree {
   }
   // A leaf's node: the light's point, its cone (an exact cone for oriented and spot lights;
   // directional trees: computeDirectionCones' cone of a single direction), its intensity.
-  LightNode leafNode(const Light& l, uint32_t index) const;
+  // Inline: the reconstruction walk and the moments make one per leaf.
+  LightNode leafNode(const Light& l, uint32_t index) const {
+    LightNode n;
+    n.intensity = leafIntensity(l);
+    n.rep = index;
+    if (type == LightType::Directional) {
+      n.lo = n.hi = -l.direction;
+      directionalLeafCone(l, n);
+    } else {
+      n.lo = n.hi = l.position;
+      const bool cone = l.type == LightType::Oriented || l.type == LightType::Spot;
+      n.axis = cone ? l.direction : Vec3(0, 0, 1);
+      n.cosHalfAngle = cone ? 1.0f : -1.0f;
+    }
+    return n;
+  }
+  static void directionalLeafCone(const Light& l, LightNode& n);
   // Node r's moments: stored for inner nodes, made from the light for a leaf.
   NodeMoments momentsOf(const LightSet& lights, NodeRef r) const {
     if (!isLeafRef(r)) return moments[r];
