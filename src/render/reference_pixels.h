@@ -24,10 +24,10 @@ void measureReference(const scene::Scene& scene, const lightcuts::LightEvaluator
                       bool reconstructed, RenderResult& res);
 
 // Fraction of the VPLs' direct contribution that their distance clamp removes, measured
-// exactly (with visibility) at primary hits of up to `points` pixels spread over the image,
-// fewer when the scene has so many VPLs that points x VPLs would exceed `maxEvaluations`.
-// 0 when the scene has no VPLs.
+// exactly (with visibility) at primary hits of `points` pixels spread over the image, over
+// every VPL or, where points x VPLs would exceed `maxEvaluations`, an evenly strided subset
+// of them at each point. 0 when the scene has no VPLs.
 double vplClampedFraction(const scene::Scene& scene, const RenderOptions& options, int points = 256,
-                          uint64_t maxEvaluations = 2'000'000);
+                          uint64_t maxEvaluations = 4'000'000);
 
 }  // namespace lc::render
