@@ -142,7 +142,7 @@ class Lightcuts final : public LightEvaluator {
     // that refining it reads only its children's cache lines, not its own again, and its
     // children's preorder positions (for the recorded cut).
     NodeRef left, right;
-    uint32_t rep, lights, leftPre, rightPre;
+    uint32_t rep, lights, pre, rightPre;  // pre: its own (the left child's is pre + 1)
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
     bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
   };
@@ -304,7 +304,7 @@ class Lightcuts final : public LightEvaluator {
         (scaled ? sumScaled : sumSq) += double(spread) * spread;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
         nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, left, right, n.rep, n.lights(),
-                                LightNode::leftPre(pre), n.rightPre(pre), fo, scaled});
+                                pre, n.rightPre(pre), fo, scaled});
       } else if (record) {
         record1(t, pre, found, false);
       }
@@ -349,7 +349,7 @@ class Lightcuts final : public LightEvaluator {
         // Its representative is hidden, and so is the whole cluster: it stays in the cut,
         // exactly 0, instead of being refined down to its lights.
         ++stats.hiddenClusters;
-        if (record) record1(cn.tree, cn.leftPre - 1, CutVisibility::Occluded, false);
+        if (record) record1(cn.tree, cn.pre, CutVisibility::Occluded, false);
         continue;
       }
       total -= cn.estimate;
@@ -375,7 +375,7 @@ class Lightcuts final : public LightEvaluator {
         ++refinedTested;
         refinedSplit += boundary;
       }
-      addNode(cn.tree, cn.left, cn.leftPre, units[0], shadows[0], boundary);
+      addNode(cn.tree, cn.left, LightNode::leftPre(cn.pre), units[0], shadows[0], boundary);
       addNode(cn.tree, cn.right, cn.rightPre, units[1], shadows[1], boundary);
       // A second stage of prefetching: the children of the nodes pushed one refinement ago
       // have arrived (addNode fetched them); fetch their representatives' lights, which the
@@ -435,7 +435,7 @@ class Lightcuts final : public LightEvaluator {
           factor = std::clamp(kept / raw, 0.5f, 2.0f);
         }
       }
-      if (record) record1(cn.tree, cn.leftPre - 1, cn.shadow.found, cn.firstOrder, factor);
+      if (record) record1(cn.tree, cn.pre, cn.shadow.found, cn.firstOrder, factor);
     }
     if (record) {
       // The cut: the nodes left in the heap, and the exact ones recorded as they came.
