@@ -545,8 +545,8 @@ TEST(CliRender, ValidSceneWritesTheImage) {
   EXPECT_EQ(filesIn(dir.path()), (std::set<std::string>{"s.ray", "out.png"}));
 }
 
-// Reconstruction cuts are on by default for lightcuts from 512 x 512 pixels, off below or
-// on request, and reported.
+// Reconstruction cuts are on by default for lightcuts from 512 x 512 pixels (every 4
+// pixels, 8 from 1024 x 1024), off below or on request, and reported.
 TEST(CliRender, ReconstructionCutsByDefaultAndOffOnRequest) {
   TempDir dir;
   writeText(dir.file("s.ray"), kHeader + "camera { position = (0,0,4); }\npoint_light { position = (0,0,4); }\n"
@@ -564,6 +564,9 @@ TEST(CliRender, ReconstructionCutsByDefaultAndOffOnRequest) {
   EXPECT_GT(a["reconstruction_samples"].get<int>(), 0);
   EXPECT_GT(a["reconstructed_points"].get<int>(), 0);
   EXPECT_EQ(stats({})["reconstruct_spacing"].get<int>(), 0);  // under 512 x 512: full cuts
+  // The spacing grows with the image's side, so that a cell spans the same share of the view.
+  EXPECT_EQ(stats({}, "1023")["reconstruct_spacing"].get<int>(), 4);
+  EXPECT_EQ(stats({"--height", "1080"}, "1920")["reconstruct_spacing"].get<int>(), 8);
   EXPECT_EQ(stats({"--reconstruct", "4"})["reconstruct_spacing"].get<int>(), 4);
   nlohmann::json b = stats({"--reconstruct", "0"}, "512");
   EXPECT_EQ(b["reconstruct_spacing"].get<int>(), 0);

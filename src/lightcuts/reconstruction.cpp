@@ -141,9 +141,15 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       }
       if (above) {
         // The children inherit states, not the entries (their `exact` starts at 0).
-        const NodeRef left = n.left(it.node);
-        if (!isLeafRef(left)) __builtin_prefetch(&tree.nodes[left]);
-        stack.push_back(Item{n.right(it.node), n.rightPre(pre), it.state});
+        // The left child is read next (an inner one is the next slot); the right one when
+        // the left subtree is done: fetched now, it has arrived by then (unfetched, its
+        // line was 15% of the merge at 8.1M lights, perf).
+        // A leaf child is its light.
+        const NodeRef left = n.left(it.node), right = n.right(it.node);
+        for (NodeRef c : {left, right})
+          __builtin_prefetch(isLeafRef(c) ? static_cast<const void*>(&lights.lights[leafLight(c)])
+                                          : static_cast<const void*>(&tree.nodes[c]));
+        stack.push_back(Item{right, n.rightPre(pre), it.state});
         it.node = left;  // the left child next: the walk stays in preorder
         it.pre = LightNode::leftPre(pre);
         descending = true;
