@@ -56,7 +56,9 @@ inline const char* methodName(Method m) { return enumName(kMethodNames, m); }
 //     1.6 x errorRatio times the estimate. A node's spread is its upper bound, or, when
 //     its representative is visible and its sibling's was not hidden, its upper minus its
 //     lower bound (what the estimate of an unoccluded cluster can be off by), for a
-//     first-order estimate scaled down where the point sees few shadow boundaries
+//     first-order estimate scaled down where the point sees few shadow boundaries; a
+//     node with a visible representative also counts the part of its cluster that may be
+//     hidden, in proportion to how often the point's clusters turned out partly hidden
 //     (evaluator.cpp). The errors of a cut have random signs, so this keeps the total
 //     error, not just each node's, near errorRatio.
 enum class CutCriterion { Walter, Total };
