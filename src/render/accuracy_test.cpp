@@ -2,6 +2,9 @@
 // instant radiosity), the acceptance criterion of the product at a size a test can afford.
 #include <gtest/gtest.h>
 
+#include <random>
+#include <string>
+
 #include "io/image_metrics.h"
 #include "io/ray_parser.h"
 #include "lights/object_lights.h"
@@ -35,6 +38,73 @@ RenderResult renderWith(const scene::Scene& s, const lightcuts::LightEvaluator& 
   o.reconstructSpacing = reconstruct;
   o.reconstructCoarseSpacing = coarse;
   return render(s, ev, o);
+}
+
+// A room of the kind scripts/gen_random_room.py writes: partitions, boxes and a pillar
+// among 2,000 point lights, six tenths in clusters under the ceiling and the rest anywhere
+// (some close to surfaces, some inside boxes), so that many clusters are partly hidden
+// from the points that see their representatives.
+std::string randomRoom(uint32_t seed, int lights) {
+  std::mt19937 rng(seed);
+  auto u = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
+  auto g = [&](float sd) { return std::normal_distribution<float>(0, sd)(rng); };
+  auto box = [](float x, float y, float z, float sx, float sy, float sz, float rot, const char* mat) {
+    return "translate(" + std::to_string(x) + "," + std::to_string(y) + "," + std::to_string(z) + ", rotate(0,1,0," +
+           std::to_string(rot) + ", scale(" + std::to_string(sx) + "," + std::to_string(sy) + "," + std::to_string(sz) +
+           ", box { material = " + mat + "; })))\n";
+  };
+  const float W = 10, H = 4, D = 10;
+  const char* wall = "{ diffuse = (0.7, 0.68, 0.65); }";
+  std::string t = "SBT-raytracer 1.0\ncamera { position = (-4.2, 2.2, 4.5); look_at = (2, 1.2, -3); aspectratio = 1.5; fov = 60; }\n";
+  t += box(0, -0.05f, 0, W, 0.1f, D, 0, "{ diffuse = (0.45, 0.4, 0.35); specular = (0.3, 0.3, 0.3); shininess = 40; }");
+  t += box(0, H + 0.05f, 0, W, 0.1f, D, 0, wall);
+  t += box(-W / 2 - 0.05f, H / 2, 0, 0.1f, H, D, 0, wall) + box(W / 2 + 0.05f, H / 2, 0, 0.1f, H, D, 0, wall);
+  t += box(0, H / 2, -D / 2 - 0.05f, W, H, 0.1f, 0, wall) + box(0, H / 2, D / 2 + 0.05f, W, H, 0.1f, 0, wall);
+  for (int i = 0; i < 3; ++i) t += box(u(-3, 3), H * 0.4f, u(-2, 2), 0.15f, H * 0.8f, u(3, 5), 0, "{ diffuse = (0.5, 0.6, 0.4); }");
+  for (int i = 0; i < 10; ++i) {
+    float sy = u(0.3f, 2);
+    t += box(u(-4, 4), sy / 2, u(-4, 4), u(0.3f, 1.5f), sy, u(0.3f, 1.5f), u(0, 3.14f), "{ diffuse = (0.6, 0.5, 0.7); }");
+  }
+  t += box(u(-3, 3), H / 2, u(-3, 3), 0.4f, H, 0.4f, 0.5f, "{ diffuse = (0.6, 0.6, 0.6); }");
+  struct P { float x, y, z; };
+  std::vector<P> centres;
+  for (int i = 0; i < 16; ++i) centres.push_back({u(-4.5f, 4.5f), u(H * 0.6f, H * 0.95f), u(-4.5f, 4.5f)});
+  for (int i = 0; i < lights; ++i) {
+    P p;
+    if (u(0, 1) < 0.6f) {
+      const P& c = centres[size_t(u(0, 15.99f))];
+      float r = u(0.1f, 0.6f);
+      p = {c.x + g(r), std::min(H - 0.05f, c.y + g(r * 0.5f)), c.z + g(r)};
+    } else {
+      p = {u(-W / 2 + 0.1f, W / 2 - 0.1f), u(0.3f, H - 0.1f), u(-D / 2 + 0.1f, D / 2 - 0.1f)};
+    }
+    float i0 = 300.0f / float(lights);
+    t += "point_light { position = (" + std::to_string(p.x) + "," + std::to_string(p.y) + "," + std::to_string(p.z) +
+         "); colour = (" + std::to_string(i0 * u(0.5f, 1)) + "," + std::to_string(i0 * u(0.5f, 1)) + "," +
+         std::to_string(i0 * u(0.5f, 1)) + "); }\n";
+  }
+  return t;
+}
+
+// The pixel's error in such a room is the sampling of each cluster's visibility by its
+// representative's ray (a partly hidden cluster whose representative is visible comes out
+// too bright), which the criterion counts with the point's boundary rate
+// (kHiddenSharePerBoundary, evaluator.cpp). Without that term 0.59% of these pixels were
+// over 2%; with it none are.
+TEST(Accuracy, LightcutsWithinTwoPercentInARoomOfPartlyHiddenClusters) {
+  auto s = scene::Scene::build(io::parseRayString(randomRoom(777, 2000), "room.ray", "."));
+  ASSERT_EQ(s->lights().size(), 2000u);
+  auto brute = lightcuts::makeBruteForce(s->lights());
+  lightcuts::LightForest forest = lightcuts::buildLightForest(s->lights());
+  auto lc = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
+  RenderOptions o;
+  o.aa = AntiAliasing::Off;
+  o.width = 96;
+  o.height = 64;
+  RenderResult ref = render(*s, *brute, o);
+  RenderResult test = render(*s, *lc, o);
+  io::ImageMetrics m = io::compareImages(ref.image, test.image);
+  EXPECT_LE(m.fraction_over_threshold, 0.002) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
 }
 
 TEST(Accuracy, LightcutsWithinTwoPercentOfBruteForceOnTheCornellBox) {
