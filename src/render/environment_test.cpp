@@ -102,7 +102,9 @@ TEST(EnvironmentFurnace, BruteForceAgreesAndThreadCountDoesNotMatter) {
   for (int y = 0; y < 24; ++y)
     for (int x = 0; x < 24; ++x) {
       EXPECT_EQ(one.image.at(x, y), two.image.at(x, y));
-      if (hitsSphere(*s, x, y, 24)) EXPECT_NEAR(b.image.at(x, y).y, 0.5f, 0.005f);
+      if (hitsSphere(*s, x, y, 24)) {
+        EXPECT_NEAR(b.image.at(x, y).y, 0.5f, 0.005f);
+      }
     }
 }
 
@@ -136,7 +138,9 @@ sphere { material = { specular = (0.25, 0.25, 0.25); shininess = 0; }; }
   RenderResult r = render(*s, *brute, o);
   for (int y = 0; y < 16; ++y)
     for (int x = 0; x < 16; ++x)
-      if (hitsSphere(*s, x, y, 16)) EXPECT_NEAR(r.image.at(x, y).y, 0.5f, 0.005f);
+      if (hitsSphere(*s, x, y, 16)) {
+        EXPECT_NEAR(r.image.at(x, y).y, 0.5f, 0.005f);
+      }
 }
 
 // A mirror reflects the environment: a reflective sphere with no diffuse term shows the
