@@ -547,7 +547,7 @@ void addRenderCommand(CLI::App& app) {
       ->check(CLI::Range(1, kMaxImageSide))
       ->group(image);
   c->add_option("--spp", a->spp,
-                fmt::format("Samples per pixel, stratified (1 = the pixel centre, antialiased by --aa); more = that "
+                fmt::format("Samples per pixel, multi-jittered (1 = the pixel centre, antialiased by --aa); more = that "
                             "many at every pixel, --aa aside; default {}",
                             d.spp))
       ->check(CLI::Range(1, 65536))
@@ -559,7 +559,7 @@ void addRenderCommand(CLI::App& app) {
         ->group(image);
     c->add_option("--aa-samples", a->aaSamples,
                   fmt::format("Adaptive antialiasing: sub-samples at a re-sampled pixel, with its centre a g x g "
-                              "stratified grid: 8 (3 x 3), 24 (5 x 5) or 48 (7 x 7); with 24 and 48 a plain surface is shaded once "
+                              "multi-jittered grid: 8 (3 x 3), 24 (5 x 5) or 48 (7 x 7); with 24 and 48 a plain surface is shaded once "
                               "per cell of a 3 x 3 grid, its other sub-samples measuring coverage; default {}",
                               d.aaSamples))
         ->check(CLI::IsMember({8, 24, 48}))

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "core/error.h"
+#include "core/multi_jitter.h"
 #include "render/reconstruction_tiles.h"
 
 namespace lc::render {
@@ -50,12 +51,9 @@ int aaGridSide(int aaSamples) {
   return 0;
 }
 
-Vec2 aaSubSamplePosition(int s, int g, Rng& rng) {
-  const int middle = (g * g) / 2;
-  int k = s < middle ? s : s + 1;
-  int ix = k % g, iy = k / g;
-  float jx = rng.uniform(), jy = rng.uniform();
-  return Vec2((float(ix) + jx) / float(g), (float(iy) + jy) / float(g));
+void aaSubSamplePositions(int g, Rng& rng, std::vector<Vec2>& out) {
+  multiJittered(g, g, rng, out, /*keepMiddle=*/true);
+  out.erase(out.begin() + (g * g) / 2);  // the centre sample's
 }
 
 namespace {
@@ -136,11 +134,13 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
                          a.m->emissive.value == m->emissive.value && a.m->ambient.value == m->ambient.value &&
                          a.m->shininess.value == m->shininess.value));
   };
+  static thread_local std::vector<Vec2> positions;
+  aaSubSamplePositions(g, rng, positions);
   std::vector<std::pair<int, int>> shadedInCell;  // (cell, surface)
   if (decouple) shadedInCell.emplace_back(4, 0);  // the centre sample
   for (int s = 0; s < n; ++s) {
     Sub& b = subs[size_t(s)];
-    b.u = aaSubSamplePosition(s, g, rng);
+    b.u = positions[size_t(s)];
     b.ray = scene::Ray{cam.eye,
                        normalize(cam.direction((float(x) + b.u.x) / float(o.width), (float(y) + b.u.y) / float(o.height))),
                        0, kInf};

@@ -36,9 +36,10 @@ std::vector<uint8_t> flagPixels(const std::vector<CentreSample>& ring, int w, in
 // The side g of the stratified grid for aaSamples = g^2 - 1 sub-samples (0 when invalid).
 int aaGridSide(int aaSamples);
 
-// Sub-sample s (0 .. g^2 - 2) of a pixel: jittered in stratum s of the g x g grid, the
-// middle stratum (the centre sample's) skipped.
-Vec2 aaSubSamplePosition(int s, int g, Rng& rng);
+// The g^2 - 1 sub-samples of a pixel: correlated multi-jittered on the g x g grid
+// (core/multi_jitter.h: one per stratum and one per thin column and row of the g^2), the
+// middle stratum's sample, the pixel's centre, left out (the centre sample stands for it).
+void aaSubSamplePositions(int g, Rng& rng, std::vector<Vec2>& out);
 
 // The random stream of a pixel's sub-samples (distinct from its fixed-spp stream).
 inline uint64_t aaStream(int x, int y, int width, int height) {

@@ -35,7 +35,7 @@ enum class AntiAliasing {
 inline constexpr EnumName<AntiAliasing> kAntiAliasingNames[] = {
     {AntiAliasing::Adaptive, "adaptive",
      "a pixel whose centre ray differs from a neighbour's in shape, in normal by more than {normal_degrees:.0f} "
-     "degrees, or in luminance by more than {contrast_percent:g}% is re-sampled with --aa-samples stratified "
+     "degrees, or in luminance by more than {contrast_percent:g}% is re-sampled with --aa-samples multi-jittered "
      "sub-samples"},
     {AntiAliasing::Off, "off", "the pixel centre only"}};
 inline const char* antiAliasingName(AntiAliasing aa) { return enumName(kAntiAliasingNames, aa); }
@@ -47,7 +47,7 @@ inline AntiAliasing parseAntiAliasing(std::string_view name) {
 struct RenderOptions {
   int width = 512;
   int height = 512;
-  int spp = 1;        // samples per pixel, stratified; 1 = the pixel centre (see aa)
+  int spp = 1;        // samples per pixel, multi-jittered; 1 = the pixel centre (see aa)
   // Adaptive antialiasing (render/adaptive.h), with spp == 1: after a tile's centre samples,
   // a pixel is flagged when one of its 8 neighbours' centre rays
   //   - hits another shape (or nothing where it hits something): a silhouette or crease;
@@ -57,8 +57,9 @@ struct RenderOptions {
   //     the larger (at least aaContrastFloor): a shadow or texture boundary, an edge seen
   //     in a mirror. (Luminance is compared within the tile only: a neighbour across a
   //     tile border is not rendered yet; geometry is compared across borders.)
-  // A flagged pixel is re-sampled on a g x g stratified grid (jittered, its own random
-  // stream, so the image is the same at any thread count): the centre sample stands for
+  // A flagged pixel is re-sampled on a g x g stratified grid (multi-jittered: also one
+  // sample per thin column and row, core/multi_jitter.h; its own random stream, so the
+  // image is the same at any thread count): the centre sample stands for
   // the middle stratum, aaSamples = g^2 - 1 new sub-samples fill the others, and the pixel
   // is their mean. Sub-samples borrow the tile's reconstruction samples where they lie on
   // the same surface (else a full lightcut). Measured on the demo (docs/LIGHTCUTS.md).

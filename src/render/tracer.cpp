@@ -6,6 +6,7 @@
 
 #include <time.h>
 
+#include "core/multi_jitter.h"
 #include "core/rng.h"
 
 namespace lc::render {
@@ -20,15 +21,21 @@ uint64_t threadCpuNanos() {
   return uint64_t(ts.tv_sec) * 1'000'000'000u + uint64_t(ts.tv_nsec);
 }
 
-// Sample s of spp inside a pixel: stratified on a near-square grid, jittered; a single
-// sample takes the pixel centre.
-Vec2 samplePosition(int s, int spp, Rng& rng) {
-  if (spp <= 1) return Vec2(0.5f, 0.5f);
-  int gx = int(std::ceil(std::sqrt(double(spp))));
-  int gy = (spp + gx - 1) / gx;
-  int ix = s % gx, iy = s / gx;
-  return Vec2((float(ix) + rng.uniform()) / float(gx), (float(iy) + rng.uniform()) / float(gy));
+}  // namespace
+
+// Multi-jittered (core/multi_jitter.h) on the squarest a x b grid with a b = spp, a >= b:
+// 8 x 8 for 64, 6 x 4 for 24, 7 x 1 for 7 (a Latin hypercube). One sample takes the centre.
+void pixelSamplePositions(int spp, Rng& rng, std::vector<Vec2>& out) {
+  if (spp <= 1) {
+    out.assign(1, Vec2(0.5f, 0.5f));
+    return;
+  }
+  int b = int(std::sqrt(double(spp)));
+  while (spp % b != 0) --b;
+  multiJittered(spp / b, b, rng, out);
 }
+
+namespace {
 
 }  // namespace
 
@@ -171,8 +178,10 @@ PixelResult renderPixel(const scene::Scene& scene, const lightcuts::LightEvaluat
   tr.errorFloor = std::max(0.0f, o.errorFloor);
   Color sum(0);
   const scene::Camera& cam = scene.camera();
+  static thread_local std::vector<Vec2> positions;
+  pixelSamplePositions(o.spp, rng, positions);
   for (int s = 0; s < o.spp; ++s) {
-    Vec2 u = samplePosition(s, o.spp, rng);
+    const Vec2 u = positions[size_t(s)];
     float sx = (float(x) + u.x) / float(o.width), sy = (float(y) + u.y) / float(o.height);
     scene::Ray ray{cam.eye, normalize(cam.direction(sx, sy)), 0, kInf};
     ++primary;
