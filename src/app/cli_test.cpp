@@ -1363,7 +1363,7 @@ TEST(CliOutput, AdaptiveAntialiasingByDefault) {
   EXPECT_EQ(d["aa"], "adaptive");
   EXPECT_GT(d["aa_pixels"].get<int>(), 20);  // the sphere's outline
   EXPECT_LT(d["aa_pixels"].get<int>(), 32 * 32 / 2);
-  EXPECT_EQ(d["primary_rays"].get<int>(), 32 * 32 + 48 * d["aa_pixels"].get<int>());
+  EXPECT_EQ(d["primary_rays"].get<int>(), 32 * 32 + 80 * d["aa_pixels"].get<int>());  // the default 80
   nlohmann::json off = stats({"--aa", "off"});
   EXPECT_EQ(off["aa_pixels"].get<int>(), 0);
   EXPECT_EQ(off["primary_rays"].get<int>(), 32 * 32);
@@ -1372,6 +1372,7 @@ TEST(CliOutput, AdaptiveAntialiasingByDefault) {
   EXPECT_EQ(fixed["primary_rays"].get<int>(), 4 * 32 * 32);
   nlohmann::json more = stats({"--aa-samples", "24"});
   EXPECT_EQ(more["primary_rays"].get<int>(), 32 * 32 + 24 * more["aa_pixels"].get<int>());
+  EXPECT_EQ(more["aa_pixels"], d["aa_pixels"]);
   CliResult bad = run({"render", "s.ray", "-o", "b.png", "--width", "8", "-q", "--aa-samples", "16"}, dir.path());
   EXPECT_NE(bad.status, 0);
 }

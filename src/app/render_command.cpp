@@ -559,10 +559,10 @@ void addRenderCommand(CLI::App& app) {
         ->group(image);
     c->add_option("--aa-samples", a->aaSamples,
                   fmt::format("Adaptive antialiasing: sub-samples at a re-sampled pixel, with its centre a g x g "
-                              "multi-jittered grid: 8 (3 x 3), 24 (5 x 5) or 48 (7 x 7); with 24 and 48 a plain surface is shaded once "
+                              "multi-jittered grid: 8 (3 x 3), 24 (5 x 5), 48 (7 x 7) or 80 (9 x 9); from 24 a plain surface is shaded once "
                               "per cell of a 3 x 3 grid, its other sub-samples measuring coverage; default {}",
                               d.aaSamples))
-        ->check(CLI::IsMember({8, 24, 48}))
+        ->check(CLI::IsMember({8, 24, 48, 80}))
         ->group(image);
   }
   c->add_option("--aov", a->aov,

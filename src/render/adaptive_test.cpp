@@ -61,7 +61,7 @@ TEST(AdaptiveFlags, ShapeNormalAndContrastEachFlagBothSides) {
 
 TEST(AdaptiveSubSamples, OneInEachStratumButTheMiddle) {
   std::vector<Vec2> p;
-  for (int n : {8, 24, 48}) {
+  for (int n : {8, 24, 48, 80}) {
     const int g = aaGridSide(n);
     ASSERT_EQ(g * g - 1, n);
     Rng rng(1, 7);
@@ -148,9 +148,9 @@ TEST(AdaptiveRender, EdgePixelsAreTheirCoverageAndOthersTheirCentre) {
       float xa = worldX(float(x) / 16), xb = worldX(float(x + 1) / 16);
       float cover = std::clamp((0.2f - std::min(xa, xb)) / std::fabs(xb - xa), 0.0f, 1.0f);
       const size_t i = size_t(y) * 16 + size_t(x);
-      // A flagged pixel's 49 samples lie one in each of 49 thin columns (multi-jittered):
+      // A flagged pixel's 81 samples lie one in each of 81 thin columns (multi-jittered):
       // the share left of the vertical edge is its coverage to within one column.
-      EXPECT_NEAR(a.image.pixels[i].x, cover, a.aaFlagged[i] ? 1.0f / 49 + 1e-3f : 0.12f) << x << "," << y;
+      EXPECT_NEAR(a.image.pixels[i].x, cover, a.aaFlagged[i] ? 1.0f / 81 + 1e-3f : 0.12f) << x << "," << y;
       if (!a.aaFlagged[i]) {
         EXPECT_EQ(a.image.pixels[i], b.image.pixels[i]);
       }
@@ -162,8 +162,8 @@ TEST(AdaptiveRender, EdgePixelsAreTheirCoverageAndOthersTheirCentre) {
     }
   EXPECT_EQ(edgePixels, 16);  // one column
   EXPECT_EQ(a.stats.aaPixels, 32u);  // the two columns either side of the edge
-  EXPECT_EQ(a.stats.aaSubSamples, 32u * 48u);  // the default 7 x 7 grid
-  EXPECT_EQ(a.stats.primaryRays, 256u + 32u * 48u);  // each sub-sample's coverage ray
+  EXPECT_EQ(a.stats.aaSubSamples, 32u * 80u);  // the default 9 x 9 grid
+  EXPECT_EQ(a.stats.primaryRays, 256u + 32u * 80u);  // each sub-sample's coverage ray (geometric edges)
   // With --spp 2, every pixel gets two samples and no more.
   RenderOptions fixed = o;
   fixed.spp = 2;
