@@ -59,11 +59,11 @@ void aaSubSamplePositions(int g, Rng& rng, std::vector<Vec2>& out) {
 
 namespace {
 
-// A mirror or glass surface, and one whose shaded sub-samples disagree, is shaded at up to
-// one sub-sample per cell of a grid of this side: every sub-sample up to 48 (7 x 7 with the
-// centre), 49 of 80; the others take the nearest shaded one's radiance, as on plain
-// surfaces (a texture is shaded at every sub-sample). Without the cap the luminous object's
-// mirrors made 80 sub-samples cost 1.4 times 48 (256², 35.0 s against 24.7 s; now 26.4 s).
+// A textured, mirror or glass surface, and one whose shaded sub-samples disagree, is shaded
+// at up to one sub-sample per cell of a grid of this side: every sub-sample up to 48 (7 x 7
+// with the centre), 49 of 80; the others take the nearest shaded one's radiance. Without the
+// cap, 80 sub-samples cost 1.4 times 48 on the luminous object's mirrors (256², 35.0 s
+// against 24.7 s; with it 26.4 s) and 1.2 times on the Roman hall's textured floor.
 constexpr int kFineShadingSide = 7;
 
 // What a pixel's sub-samples add: their radiance, cut nodes and shadow rays, summed.
@@ -108,6 +108,8 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
     scene::Ray ray;
     bool hit = false;
     int surface = -1;  // index into `surfaces`
+    const scene::Material* m = nullptr;  // of its hit
+    bool byMaterial = false;  // textured, mirror or glass: shares shading by material (below)
     bool shade = true;
     Color c{0};
   };
@@ -152,8 +154,11 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
   auto fineCell = [side](const Vec2& u) {
     return std::min(side - 1, int(u.x * float(side))) + side * std::min(side - 1, int(u.y * float(side)));
   };
-  std::vector<std::pair<int, int>> shadedInFineCell;  // (fine cell, surface) of such surfaces
-  shadedInFineCell.emplace_back(fineCell(Vec2(0.5f, 0.5f)), 0);
+  // (fine cell, material) shaded for such surfaces: keyed by the material, not the surface,
+  // since which surface a sub-sample joins is a threshold decision that float-level
+  // differences in the hits can flip (an OBJ read directly and converted, ObjRoundTrip).
+  std::vector<std::pair<int, const scene::Material*>> shadedInFineCell;
+  if (decouple && surfaces[0].m) shadedInFineCell.emplace_back(fineCell(Vec2(0.5f, 0.5f)), surfaces[0].m);
   for (int s = 0; s < n; ++s) {
     Sub& b = subs[size_t(s)];
     b.u = positions[size_t(s)];
@@ -171,13 +176,10 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
       b.surface = int(surfaces.size());
       surfaces.push_back(Surface{b.hit, hit.p, hit.ns, hit.t, m});
     }
+    b.m = m;
     if (m && shadeEverySubSample(*m)) {
-      // A texture is shaded at every sub-sample still: which surface a sub-sample joins is
-      // a threshold decision, and an OBJ read directly and converted (ObjRoundTrip) must
-      // not differ by one; a mirror or glass surface at one per fine cell.
-      const bool textured = m->reflective.isBlack() && m->transmissive.isBlack();
-      const std::pair<int, int> fine{fineCell(b.u), b.surface};
-      if (textured) continue;
+      b.byMaterial = true;
+      const std::pair<int, const scene::Material*> fine{fineCell(b.u), m};
       if (std::find(shadedInFineCell.begin(), shadedInFineCell.end(), fine) != shadedInFineCell.end()) {
         b.shade = false;
       } else {
@@ -250,12 +252,14 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
   for (int s = 0; s < n; ++s) {
     Sub& b = subs[size_t(s)];
     if (!b.shade) {
-      // The nearest shaded sub-sample on the same surface (the centre included).
+      // The nearest shaded sub-sample on the same surface (the centre included), or of the
+      // same material where shading is shared by material (one is in its fine cell).
       float best = kInf;
       Color c = centre;
-      if (b.surface == 0) best = dist2(b.u, Vec2(0.5f, 0.5f));
+      auto alike = [&](const Sub& o2) { return b.byMaterial ? o2.byMaterial && o2.m == b.m : o2.surface == b.surface; };
+      if (b.byMaterial ? surfaces[0].m == b.m : b.surface == 0) best = dist2(b.u, Vec2(0.5f, 0.5f));
       for (const Sub& o2 : subs)
-        if (o2.shade && o2.surface == b.surface) {
+        if (o2.shade && alike(o2)) {
           const float d = dist2(b.u, o2.u);
           if (d < best) {
             best = d;

@@ -129,6 +129,37 @@ translate(0, -1, 0, scale(6, 0.1, 6, box { material = { diffuse = (0.6, 0.6, 0.6
   EXPECT_LT(a.stats.eval.shadowRays, b.stats.eval.shadowRays);
 }
 
+// A mirror sphere over a lit floor: its sub-samples are shaded at most once per cell of the
+// 7 x 7 fine grid (per material), so 80 coverage samples cost no more shading than 48, and
+// the image stays within 2% of shading all 80 on all but a few edge pixels.
+TEST(AdaptiveRender, MirrorsAreShadedOncePerFineCellWithEightySamples) {
+  auto s = sceneFrom(R"(SBT-raytracer 1.0
+camera { position = (0, 1, 5); viewdir = (0, -0.1, -1); updir = (0, 1, 0); fov = 50; }
+point_light { position = (1, 4, 2); colour = (3, 3, 3); }
+sphere { material = { diffuse = (0.05, 0.05, 0.05); reflective = (0.9, 0.9, 0.9); }; }
+translate(0, -1, 0, scale(6, 0.1, 6, box { material = { diffuse = (0.6, 0.5, 0.4); }; }))
+)");
+  auto ev = lightcuts::makeBruteForce(s->lights());
+  RenderOptions o;
+  o.width = o.height = 40;
+  o.aaSamples = 48;
+  RenderResult r48 = render(*s, *ev, o);
+  o.aaSamples = 80;
+  RenderResult r80 = render(*s, *ev, o);
+  ASSERT_GT(r80.stats.aaPixels, 40u);
+  EXPECT_EQ(r80.stats.aaPixels, r48.stats.aaPixels);
+  EXPECT_EQ(r80.stats.aaSubSamples, 80u * r80.stats.aaPixels);
+  // The mirror's and the floor's shadings: about those of 48 sub-samples, far from 80.
+  const double extra48 = double(r48.stats.eval.shadingPoints), extra80 = double(r80.stats.eval.shadingPoints);
+  EXPECT_LT(extra80, 1.15 * extra48) << extra48 << " " << extra80;
+  int over = 0;
+  for (size_t i = 0; i < r80.image.pixels.size(); ++i) {
+    const float a = luminance(r80.image.pixels[i]), b = luminance(r48.image.pixels[i]);
+    over += std::fabs(a - b) > 0.1f * std::max(b, 0.05f);
+  }
+  EXPECT_LE(over, int(r80.image.pixels.size() / 50)) << "pixels over 10% apart from 48 sub-samples";
+}
+
 TEST(AdaptiveRender, EdgePixelsAreTheirCoverageAndOthersTheirCentre) {
   auto s = sceneFrom(kEdgeScene);
   auto ev = lightcuts::makeBruteForce(s->lights());
