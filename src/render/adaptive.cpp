@@ -148,8 +148,8 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
   aaSubSamplePositions(g, rng, positions);
   std::vector<std::pair<int, int>> shadedInCell;  // (cell, surface)
   if (decouple) shadedInCell.emplace_back(4, 0);  // the centre sample
-  // The fine grid (kFineShadingSide): a surface shaded at every sub-sample (a mirror or
-  // glass, or shaded samples that disagree, below) is shaded at one per fine cell.
+  // The fine grid (kFineShadingSide): a surface shaded at every sub-sample (textured, a
+  // mirror or glass, or shaded samples that disagree, below) is shaded at one per fine cell.
   const int side = std::min(g, kFineShadingSide);
   auto fineCell = [side](const Vec2& u) {
     return std::min(side - 1, int(u.x * float(side))) + side * std::min(side - 1, int(u.y * float(side)));
