@@ -35,10 +35,6 @@ void pixelSamplePositions(int spp, Rng& rng, std::vector<Vec2>& out) {
   multiJittered(spp / b, b, rng, out);
 }
 
-namespace {
-
-}  // namespace
-
 Color ShadowRays::operator()(const Vec3& wi, float dist) {
   return timed([&] {
     float tmax;
