@@ -45,7 +45,16 @@ int main(int argc, char** argv) {
       side.at(w + x, y) = ref.at(x, y);
     }
   size_t edges = 0, under = 0, geometric = 0, geoUnder = 0, flat = 0, flatUnder = 0;
-  const bool list = std::getenv("AA_EDGES_LIST") != nullptr;  // print each geometric edge pixel over 2%
+  // AA_EDGES_LIST=1: print each geometric edge pixel over 2%; =all: every edge pixel over 2%,
+  // with its kind and (when TEST has --aov samples) the camera samples it took.
+  const char* listEnv = std::getenv("AA_EDGES_LIST");
+  const bool list = listEnv != nullptr, listAll = list && std::string(listEnv) == "all";
+  std::vector<float> samples;
+  try {
+    int sw = 0, sh = 0;
+    samples = io::readExrChannel(argv[2], "samples.Y", sw, sh);
+  } catch (const std::exception&) {
+  }
   double sum = 0;
   std::vector<double> errs;
   for (int y = 0; y < h; ++y)
@@ -83,8 +92,10 @@ int main(int argc, char** argv) {
       sum += e;
       under += e < 0.02;
       geoUnder += geo && e < 0.02;
-      if (list && geo && e >= 0.02)
-        std::printf("over: %d %d ref %.4f test %.4f err %.2f%%\n", x, y, r, t, 100 * e);
+      if (list && (geo || listAll) && e >= 0.02)
+        std::printf("over: %d %d ref %.4f test %.4f err %.2f%% %s samples %g\n", x, y, r, t, 100 * e,
+                    geo ? "geometric" : "contrast",
+                    samples.empty() ? 0.0 : double(samples[size_t(y0 + y) * size_t(test.width) + size_t(x0 + x)]));
     }
   std::sort(errs.begin(), errs.end());
   const double p99 = errs.empty() ? 0 : errs[std::min(errs.size() - 1, size_t(0.99 * double(errs.size())))];

@@ -377,7 +377,7 @@ std::vector<Row> catalogue() {
                      "--aov needs an .exr output (its layers are extra EXR channels); 'out.png' is .png",
                      {"--aov", "depth"}));
   rows.push_back(ray("aov_unknown", "sphere {}",
-                     "--aov: unknown output 'dpth\\x1b' (use albedo, normal, depth, cut, shadow_rays, comma-separated)",
+                     "--aov: unknown output 'dpth\\x1b' (use albedo, normal, depth, cut, shadow_rays, samples, comma-separated)",
                      {"--aov", "albedo,dpth\x1b"}));
   rows.push_back(ray("aspect_ratio_too_wide", "camera { aspectratio = 3e9; }",
                      "aspectratio 3000000000 makes the image 3000000000x1: more than 65536 pixels wide (give both --width and --height)",
@@ -1303,7 +1303,7 @@ TEST(CliOutput, AovLayersInTheExr) {
                                        "scale(10, square { material = { diffuse = (0.5,0.6,0.7); }; })\n");
   const int W = 12, H = 10;
   CliResult r = run({"render", "plane.ray", "-o", "out.exr", "--width", std::to_string(W), "--height",
-                     std::to_string(H), "-q", "--aov", "albedo,normal,depth,cut,shadow_rays"},
+                     std::to_string(H), "-q", "--aov", "albedo,normal,depth,cut,shadow_rays,samples"},
                     dir.path());
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string exr = dir.file("out.exr");
@@ -1320,6 +1320,7 @@ TEST(CliOutput, AovLayersInTheExr) {
   std::vector<float> ar = channel("albedo.R"), ag = channel("albedo.G"), ab = channel("albedo.B");
   std::vector<float> nx = channel("normal.X"), ny = channel("normal.Y"), nz = channel("normal.Z");
   std::vector<float> depth = channel("depth.Z"), cut = channel("cut.Y"), rays = channel("shadow_rays.Y");
+  std::vector<float> samples = channel("samples.Y");
   const float tanHalf = std::tan(30.0f * 3.14159265f / 180.0f);
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
@@ -1336,6 +1337,7 @@ TEST(CliOutput, AovLayersInTheExr) {
       EXPECT_NEAR(depth[i], 5.0f * std::sqrt(1 + a * a + b * b), 1e-3f) << x << "," << y;
       EXPECT_FLOAT_EQ(cut[i], 1.0f);   // one light: a cut of one node
       EXPECT_FLOAT_EQ(rays[i], 1.0f);  // and its shadow ray
+      EXPECT_TRUE(samples[i] == 1.0f || samples[i] == 81.0f) << samples[i];  // the centre, or 9 x 9
     }
   // Names are checked; 8-bit outputs have no layers.
   CliResult png = run({"render", "plane.ray", "-o", "out.png", "--width", "8", "-q", "--aov", "depth"}, dir.path());
@@ -1375,4 +1377,18 @@ TEST(CliOutput, AdaptiveAntialiasingByDefault) {
   EXPECT_EQ(more["aa_pixels"], d["aa_pixels"]);
   CliResult bad = run({"render", "s.ray", "-o", "b.png", "--width", "8", "-q", "--aa-samples", "16"}, dir.path());
   EXPECT_NE(bad.status, 0);
+  // --aov samples: 81 at the re-sampled pixels, 1 elsewhere; --spp N everywhere.
+  auto samples = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args{"render", "s.ray", "-o", "o.exr", "--width", "32", "-q", "--aov", "samples"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    CliResult r = run(args, dir.path());
+    EXPECT_EQ(r.status, 0) << r.err;
+    int w = 0, h = 0;
+    return lc::io::readExrChannel(dir.file("o.exr"), "samples.Y", w, h);
+  };
+  std::vector<float> s = samples({});
+  EXPECT_EQ(std::count(s.begin(), s.end(), 81.0f), d["aa_pixels"].get<long>());
+  EXPECT_EQ(std::count(s.begin(), s.end(), 1.0f), 32 * 32 - d["aa_pixels"].get<long>());
+  std::vector<float> s4 = samples({"--spp", "4"});
+  EXPECT_EQ(std::count(s4.begin(), s4.end(), 4.0f), 32 * 32);
 }

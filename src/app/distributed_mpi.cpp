@@ -88,7 +88,7 @@ std::vector<char> receiveBytes(const MPI_Status& st) {
 // and shadow rays (the --aov layers) as floats, then its done flags. Exact: the floats are
 // copied, not converted.
 struct PixelRecord {
-  float r, g, b, cut, rays;
+  float r, g, b, cut, rays, centre;  // centre: RenderResult::centreLuminance
 };
 
 std::vector<char> packTile(int tile, const TileRect& t, const RenderResult& res) {
@@ -103,7 +103,8 @@ std::vector<char> packTile(int tile, const TileRect& t, const RenderResult& res)
     for (int x = t.x0; x < t.x1; ++x) {
       size_t i = size_t(y) * size_t(w) + size_t(x);
       const Color& c = res.image.pixels[i];
-      PixelRecord r{c.x, c.y, c.z, res.cutSize[i], i < res.shadowRays.size() ? res.shadowRays[i] : 0.0f};
+      PixelRecord r{c.x, c.y, c.z, res.cutSize[i], i < res.shadowRays.size() ? res.shadowRays[i] : 0.0f,
+                    i < res.centreLuminance.size() ? res.centreLuminance[i] : 0.0f};
       std::memcpy(px, &r, sizeof r);
       px += sizeof r;
       // The done flag, and in bit 1 whether adaptive antialiasing re-sampled the pixel.
@@ -133,6 +134,7 @@ bool unpackTile(const std::vector<char>& buf, const TileGrid& grid, RenderResult
       res.image.pixels[i] = Color(r.r, r.g, r.b);
       res.cutSize[i] = r.cut;
       if (i < res.shadowRays.size()) res.shadowRays[i] = r.rays;
+      if (i < res.centreLuminance.size()) res.centreLuminance[i] = r.centre;
       const uint8_t flags = uint8_t(*done++);
       res.done[i] = flags & 1;
       if (i < res.aaFlagged.size()) res.aaFlagged[i] = (flags >> 1) & 1;

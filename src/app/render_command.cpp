@@ -106,7 +106,8 @@ const std::vector<AovKind> kAovs = {{"albedo", {"R", "G", "B"}},
                                     {"normal", {"X", "Y", "Z"}},
                                     {"depth", {"Z"}},
                                     {"cut", {"Y"}},
-                                    {"shadow_rays", {"Y"}}};
+                                    {"shadow_rays", {"Y"}},
+                                    {"samples", {"Y"}}};
 
 std::vector<std::string> parseAovs(const std::string& list) {
   std::vector<std::string> out;
@@ -117,7 +118,7 @@ std::vector<std::string> parseAovs(const std::string& list) {
     bool known = false;
     for (const AovKind& k : kAovs) known = known || name == k.name;
     if (!known)
-      throw Error(fmt::format("--aov: unknown output {} (use albedo, normal, depth, cut, shadow_rays, "
+      throw Error(fmt::format("--aov: unknown output {} (use albedo, normal, depth, cut, shadow_rays, samples, "
                               "comma-separated)",
                               quoteInput(name)));
     if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
@@ -139,6 +140,16 @@ std::vector<io::WriteOptions::Channel> aovChannels(const std::vector<std::string
   for (const std::string& name : names) {
     if (name == "cut" || name == "shadow_rays") {
       out.push_back({name + ".Y", name == "cut" ? rr.cutSize : rr.shadowRays});
+      continue;
+    }
+    if (name == "samples") {
+      // Camera samples taken at each pixel: --spp, or 1 and, where adaptive antialiasing
+      // re-sampled the pixel, its sub-samples too: where the render spent its extra rays.
+      const float flagged = float(1 + ro.aaSamples);
+      std::vector<float> v(n, float(ro.spp));
+      if (ro.spp == 1 && ro.aa == render::AntiAliasing::Adaptive)
+        for (size_t i = 0; i < n && i < rr.aaFlagged.size(); ++i) v[i] = rr.aaFlagged[i] ? flagged : 1.0f;
+      out.push_back({"samples.Y", std::move(v)});
       continue;
     }
     if (name == "depth") {
@@ -569,7 +580,8 @@ void addRenderCommand(CLI::App& app) {
                 "Extra outputs as layers of the .exr output, comma-separated: albedo (albedo.R/G/B: the diffuse "
                 "colour at the pixel centre's hit), normal (normal.X/Y/Z: its shading normal, facing the camera), "
                 "depth (depth.Z: distance along the camera ray, inf for none), cut (cut.Y: lights in the cut per "
-                "sample), shadow_rays (shadow_rays.Y: per sample); the image stays R, G, B; default none")
+                "sample), shadow_rays (shadow_rays.Y: per sample), samples (samples.Y: camera samples taken at the pixel, "
+                "showing where antialiasing re-sampled); the image stays R, G, B; default none")
       ->group(output);
   c->add_option("--max-depth", a->maxDepth, fmt::format("Reflection/refraction recursion depth; default {}", d.maxDepth))
       ->check(CLI::Range(0, 64))

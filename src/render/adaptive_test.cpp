@@ -9,8 +9,10 @@
 #include <cmath>
 #include <set>
 
+#include "io/image.h"
 #include "io/ray_parser.h"
 #include "lightcuts/light_tree.h"
+#include "test_util.h"
 
 namespace lc::render {
 namespace {
@@ -43,7 +45,7 @@ TEST(AdaptiveFlags, ShapeNormalAndContrastEachFlagBothSides) {
   EXPECT_FALSE(disagree(hitOn(1, z, 5.0f), hitOn(1, z, 3.0f), o));  // both white on screen
   EXPECT_FALSE(disagree(hitOn(1, z, 0.001f), hitOn(1, z, 0.002f), o));  // below the floor
   CentreSample unknown = hitOn(1, z, 0.0f);
-  unknown.known = false;  // across a tile border: luminance not compared
+  unknown.known = false;  // across a tile border: luminance not compared here (seamPixels)
   EXPECT_FALSE(disagree(hitOn(1, z, 0.5f), unknown, o));
   CentreSample outside;
   outside.shape = -2;
@@ -57,6 +59,82 @@ TEST(AdaptiveFlags, ShapeNormalAndContrastEachFlagBothSides) {
   std::vector<uint8_t> f = flagPixels(ring, w, h, o);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) EXPECT_EQ(f[size_t(y) * w + x], x == 1 || x == 2) << x << "," << y;
+}
+
+// A bend of more than aaStep along three centres flags the middle one: a step of lower
+// contrast than aaContrast does, a straight ramp (however steep) does not.
+TEST(AdaptiveFlags, StepsFlagABendNotAStraightRamp) {
+  RenderOptions o;
+  const Vec3 z(0, 0, 1);
+  auto at = [&](float l) { return hitOn(1, z, l); };
+  EXPECT_FALSE(steps(at(0.3f), at(0.4f), at(0.5f), o));    // a ramp: no bend
+  EXPECT_TRUE(steps(at(0.5f), at(0.5f), at(0.44f), o));    // a 12% step: disagree() misses it
+  EXPECT_FALSE(disagree(at(0.5f), at(0.44f), o));
+  EXPECT_FALSE(steps(at(0.5f), at(0.5f), at(0.48f), o));   // 4%: noise
+  EXPECT_TRUE(steps(at(0.5f), at(0.56f), at(0.5f), o));    // a thin bright line
+  EXPECT_FALSE(steps(at(3.0f), at(1.5f), at(1.2f), o));    // white on screen
+  CentreSample unknown = at(0.0f);
+  unknown.known = false;
+  EXPECT_FALSE(steps(at(0.5f), at(0.5f), unknown, o));
+  o.aaStep = 0;  // off
+  EXPECT_FALSE(steps(at(0.5f), at(0.5f), at(0.2f), o));
+
+  // A 6 x 3 tile: a ramp of 12-15% per column, then the same with a 12% step in it.
+  RenderOptions d;
+  const int w = 6, h = 3;
+  std::vector<CentreSample> ring(size_t(w + 2) * size_t(h + 2));
+  auto fill = [&](auto lum) {
+    for (int y = 0; y < h + 2; ++y)
+      for (int x = 0; x < w + 2; ++x) {
+        CentreSample c = at(lum(x));
+        c.known = x >= 1 && x <= w && y >= 1 && y <= h;
+        ring[size_t(y) * (w + 2) + x] = c;
+      }
+  };
+  fill([](int x) { return 0.40f + 0.06f * float(x); });
+  std::vector<uint8_t> f = flagPixels(ring, w, h, d);
+  EXPECT_EQ(std::count(f.begin(), f.end(), 1), 0);
+  fill([](int x) { return x < 4 ? 0.5f : 0.44f; });  // the step between tile columns 2 and 3
+  f = flagPixels(ring, w, h, d);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) EXPECT_EQ(f[size_t(y) * w + x], x == 2 || x == 3) << x << "," << y;
+}
+
+// The seams: a pixel on a tile border is compared with its neighbours across it after every
+// tile is done; pixels inside tiles, and those flagged already, are not listed.
+TEST(AdaptiveSeams, BordersAreComparedAcrossTiles) {
+  RenderOptions o;
+  o.width = 8;
+  o.height = 4;
+  RenderResult res;
+  res.image = io::Image(8, 4);
+  res.aaFlagged.assign(32, 0);
+  res.centreLuminance.assign(32, 0.0f);
+  auto setColumns = [&](auto lum) {
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 8; ++x) res.centreLuminance[size_t(y) * 8 + size_t(x)] = lum(x);
+  };
+  // A 20% step between columns 3 and 4, on the border of 4-pixel tiles: under aaContrast,
+  // over aaStep.
+  setColumns([](int x) { return x < 4 ? 0.5f : 0.4f; });
+  std::vector<std::pair<int, int>> s = seamPixels(res, o, 4);
+  ASSERT_EQ(s.size(), 8u);
+  for (auto [x, y] : s) EXPECT_TRUE(x == 3 || x == 4) << x << "," << y;
+  EXPECT_EQ(s.front(), std::make_pair(3, 0));  // row order
+  // With tiles of 8 the step is inside a tile: adaptiveTile's, not a seam.
+  EXPECT_TRUE(seamPixels(res, o, 8).empty());
+  // Pixels flagged already are not listed again.
+  for (int y = 0; y < 4; ++y) res.aaFlagged[size_t(y) * 8 + 3] = 1;
+  s = seamPixels(res, o, 4);
+  ASSERT_EQ(s.size(), 4u);
+  for (auto [x, y] : s) EXPECT_EQ(x, 4);
+  // A smooth ramp across the border is not a seam; nor anything with antialiasing off.
+  res.aaFlagged.assign(32, 0);
+  setColumns([](int x) { return 0.3f + 0.05f * float(x); });
+  EXPECT_TRUE(seamPixels(res, o, 4).empty());
+  setColumns([](int x) { return x < 4 ? 0.5f : 0.4f; });
+  o.aa = AntiAliasing::Off;
+  EXPECT_TRUE(seamPixels(res, o, 4).empty());
 }
 
 TEST(AdaptiveSubSamples, OneInEachStratumButTheMiddle) {
@@ -127,6 +205,54 @@ translate(0, -1, 0, scale(6, 0.1, 6, box { material = { diffuse = (0.6, 0.6, 0.6
   }
   EXPECT_LE(over, int(a.image.pixels.size() / 100)) << "pixels over 2% of full shading";
   EXPECT_LT(a.stats.eval.shadowRays, b.stats.eval.shadowRays);
+}
+
+// A floor with a diffuse checker texture: its sub-samples share shading like a plain
+// surface's (one per cell of the 3 x 3 grid), each scaled by its own texel, and the image
+// matches shading every sub-sample within 2%; the same floor with a specular term keeps the fine
+// grid's 49 shadings (the ratio would scale its highlight by the texture too).
+TEST(AdaptiveRender, DiffuseTexturesShareShadingScaledByTheirTexels) {
+  lc::testing::TempDir dir;
+  io::Image checker(8, 8);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 8; ++x) checker.at(x, y) = Color((x + y) % 2 ? 0.8f : 0.2f);
+  io::writeImage(dir.file("checker.png"), checker);
+  auto sceneWith = [&](const std::string& specular) {
+    return sceneFrom("SBT-raytracer 1.0\n"
+                     "camera { position = (0, 3, 6); viewdir = (0, -0.5, -1); updir = (0, 1, 0); fov = 45; }\n"
+                     "point_light { position = (0, 6, 1); colour = (30, 30, 30); }\n"
+                     "rotate(1, 0, 0, -1.5707963, scale(10, square { material = { diffuse = map(\"" +
+                     dir.file("checker.png") + "\"); specular = " + specular + "; shininess = 20; }; }))\n");
+  };
+  auto ev = [](const scene::Scene& s) { return lightcuts::makeBruteForce(s.lights()); };
+  RenderOptions o;
+  o.width = o.height = 32;
+  for (const char* specular : {"(0, 0, 0)", "(0.3, 0.3, 0.3)"}) {
+    SCOPED_TRACE(specular);
+    auto s = sceneWith(specular);
+    auto e = ev(*s);
+    RenderResult shared = render(*s, *e, o);
+    RenderOptions every = o;
+    every.aaDecoupled = false;
+    RenderResult all = render(*s, *e, every);
+    ASSERT_GT(shared.stats.aaPixels, 50u);  // the checker's edges
+    ASSERT_EQ(shared.stats.aaPixels, all.stats.aaPixels);
+    const double perPixel = double(shared.stats.eval.shadingPoints - uint64_t(o.width * o.height)) /
+                            double(shared.stats.aaPixels);
+    if (std::string(specular) == "(0, 0, 0)") {
+      EXPECT_LE(perPixel, 12.0);  // ~9: one per cell of the 3 x 3 grid per texel seen
+    } else {
+      EXPECT_GE(perPixel, 30.0);  // the fine grid
+    }
+    int over = 0;
+    for (size_t i = 0; i < shared.image.pixels.size(); ++i) {
+      const float a = luminance(shared.image.pixels[i]), b = luminance(all.image.pixels[i]);
+      over += std::fabs(a - b) > 0.02f * std::max(b, 0.05f);
+    }
+    // (The floor's far edge, where a pixel spans a long stretch of it, is ~1.5% off: the
+    // light varies within a cell there, as on a plain surface.)
+    EXPECT_LE(over, int(shared.image.pixels.size() / 100)) << "pixels over 2% apart from shading every sub-sample";
+  }
 }
 
 // A mirror sphere over a lit floor: its sub-samples are shaded at most once per cell of the

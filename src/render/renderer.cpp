@@ -126,6 +126,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   res.done.assign(size_t(o.width) * size_t(o.height), 0);
   res.shadowRays.assign(size_t(o.width) * size_t(o.height), 0.0f);
   res.aaFlagged.assign(size_t(o.width) * size_t(o.height), 0);
+  res.centreLuminance.assign(size_t(o.width) * size_t(o.height), 0.0f);
   std::unique_ptr<tbb::global_control> threads;
   if (o.threads > 0)
     threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(o.threads));
@@ -217,6 +218,19 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
       }
     });
     share->endTiles();
+  }
+  // The tile borders' luminance, compared across them: on the gathering process, which has
+  // every tile now (the others' share of the image is partial).
+  if (!(o.cancel && o.cancel->load()) && (!share || share->gathers())) {
+    const std::vector<std::pair<int, int>> seams = seamPixels(res, o, grid.tile);
+    const int g = aaGridSide(o.aaSamples);
+    tbb::parallel_for(size_t(0), seams.size(), [&](size_t k) {
+      if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;
+      resamplePixel(scene, evaluator, o, res, locals.local().counts, seams[k].first, seams[k].second, g, nullptr,
+                    nullptr);
+    });
+    int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t0).count();
+    if (!seams.empty()) lastTileNs = std::max(lastTileNs.load(), ns);
   }
   res.stats.tileSeconds = double(lastTileNs.load()) * 1e-9;
   res.stats.seconds = secondsSince(t0) + floorSeconds;

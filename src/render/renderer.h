@@ -30,13 +30,13 @@ enum class AntiAliasing {
 };
 
 // Its names (core/enum_names.h), read by the functions below and by render --aa. Adaptive's
-// words name RenderOptions' thresholds, {normal_degrees} and {contrast_percent}, which
-// antiAliasingHelp fills in.
+// words name RenderOptions' thresholds, {normal_degrees}, {contrast_percent} and
+// {step_percent}, which antiAliasingHelp fills in.
 inline constexpr EnumName<AntiAliasing> kAntiAliasingNames[] = {
     {AntiAliasing::Adaptive, "adaptive",
      "a pixel whose centre ray differs from a neighbour's in shape, in normal by more than {normal_degrees:.0f} "
-     "degrees, or in luminance by more than {contrast_percent:g}% is re-sampled with --aa-samples multi-jittered "
-     "sub-samples"},
+     "degrees, or in luminance by more than {contrast_percent:g}% (or on a step of {step_percent:g}% along three "
+     "pixels) is re-sampled with --aa-samples multi-jittered sub-samples"},
     {AntiAliasing::Off, "off", "the pixel centre only"}};
 inline const char* antiAliasingName(AntiAliasing aa) { return enumName(kAntiAliasingNames, aa); }
 // Throws lc::Error for another name.
@@ -55,8 +55,10 @@ struct RenderOptions {
   //     edge between faces of one mesh;
   //   - differs in luminance (each clamped to 1, as displayed) by more than aaContrast of
   //     the larger (at least aaContrastFloor): a shadow or texture boundary, an edge seen
-  //     in a mirror. (Luminance is compared within the tile only: a neighbour across a
-  //     tile border is not rendered yet; geometry is compared across borders.)
+  //     in a mirror;
+  //   - or sits on a step in luminance along a line of three centres (aaStep below).
+  // (Within a tile, right after its centre samples; across tile borders, whose neighbours
+  // were not rendered yet, once every tile is done: seamPixels, adaptive.h.)
   // A flagged pixel is re-sampled on a g x g stratified grid (multi-jittered: also one
   // sample per thin column and row, core/multi_jitter.h; its own random stream, so the
   // image is the same at any thread count): the centre sample stands for
@@ -67,6 +69,13 @@ struct RenderOptions {
   int aaSamples = 80;            // g^2 - 1 for odd g: 8 (3 x 3), 24 (5 x 5), 48 (7 x 7) or 80 (9 x 9)
   float aaContrast = 0.25f;      // relative luminance contrast that flags a pixel (docs/LIGHTCUTS.md)
   float aaContrastFloor = 0.02f; // luminance below which differences do not count relative
+  // Also flagged: a pixel where the luminance along a row, column or diagonal of three
+  // centres bends by more than aaStep of the largest (|a + b - 2c|): a step of lower contrast
+  // than aaContrast (a shadow of one light among several, a texture's edge) that still puts
+  // the centre off the pixel's mean, where a straight gradient does not. A step of contrast
+  // c puts the centre up to c/2 off; 2% as displayed (sRGB) is about 5% in linear
+  // luminance at mid-tones, so steps from 10% are flagged (docs/LIGHTCUTS.md).
+  float aaStep = 0.1f;
   float aaNormalCos = 0.9f;      // cos of the normal difference that flags (~25 degrees)
   // From 24 sub-samples, shade a plain (untextured, not mirror or glass) surface once per
   // cell of a 3 x 3 grid; its other sub-samples there measure coverage and take the
@@ -159,6 +168,9 @@ struct RenderResult {
   std::vector<float> cutSize;  // per pixel: cut nodes summed over its shading points / spp
   std::vector<float> shadowRays;  // per pixel: shadow rays over its samples / samples
   std::vector<uint8_t> aaFlagged;  // per pixel: 1 when adaptive antialiasing re-sampled it
+  // Per pixel: its centre sample's luminance as adaptive antialiasing compares it (clamped
+  // to 1), kept for the comparisons across tile borders (seamPixels).
+  std::vector<float> centreLuminance;
   RenderStats stats;
   bool interrupted = false;
   std::vector<uint8_t> done;   // per pixel: 1 when rendered (an interrupted render is partial)
