@@ -1365,6 +1365,7 @@ TEST(CliOutput, AdaptiveAntialiasingByDefault) {
   EXPECT_EQ(d["aa"], "adaptive");
   EXPECT_GT(d["aa_pixels"].get<int>(), 20);  // the sphere's outline
   EXPECT_LT(d["aa_pixels"].get<int>(), 32 * 32 / 2);
+  EXPECT_LE(d["aa_seam_pixels"].get<int>(), d["aa_pixels"].get<int>());
   EXPECT_EQ(d["primary_rays"].get<int>(), 32 * 32 + 80 * d["aa_pixels"].get<int>());  // the default 80
   nlohmann::json off = stats({"--aa", "off"});
   EXPECT_EQ(off["aa_pixels"].get<int>(), 0);

@@ -73,6 +73,7 @@ nlohmann::json renderCountersJson(const render::RenderStats& st) {
   j["reconstruction_fallbacks"] = st.reconstructionFallbacks;
   j["reconstruction_coarse_cells"] = st.reconstructionCoarseCells;
   j["aa_pixels"] = st.aaPixels;
+  j["aa_seam_pixels"] = st.aaSeamPixels;
   j["aa_sub_samples"] = st.aaSubSamples;
   return j;
 }
@@ -88,6 +89,7 @@ void addRenderCounters(render::RenderStats& st, const nlohmann::json& j) {
   st.reconstructionFallbacks += j.at("reconstruction_fallbacks").get<uint64_t>();
   st.reconstructionCoarseCells += j.at("reconstruction_coarse_cells").get<uint64_t>();
   st.aaPixels += j.at("aa_pixels").get<uint64_t>();
+  st.aaSeamPixels += j.at("aa_seam_pixels").get<uint64_t>();
   st.aaSubSamples += j.at("aa_sub_samples").get<uint64_t>();
 }
 
@@ -153,6 +155,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["aa"] = render::antiAliasingName(a.spp == 1 ? a.aa : render::AntiAliasing::Off);
   j["aa_samples"] = a.aaSamples;
   j["aa_pixels"] = rr.stats.aaPixels;
+  j["aa_seam_pixels"] = rr.stats.aaSeamPixels;  // of aa_pixels, flagged across tile borders
   j["aa_sub_samples"] = rr.stats.aaSubSamples;
   j["threads"] = a.threads > 0 ? a.threads : int(std::thread::hardware_concurrency());
   j["method"] = lightcuts::methodName(method);

@@ -223,6 +223,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   // every tile now (the others' share of the image is partial).
   if (!(o.cancel && o.cancel->load()) && (!share || share->gathers())) {
     const std::vector<std::pair<int, int>> seams = seamPixels(res, o, grid.tile);
+    res.stats.aaSeamPixels = seams.size();
     const int g = aaGridSide(o.aaSamples);
     tbb::parallel_for(size_t(0), seams.size(), [&](size_t k) {
       if (o.cancel && o.cancel->load(std::memory_order_relaxed)) return;

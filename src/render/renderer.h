@@ -158,6 +158,7 @@ struct RenderStats {
   uint64_t reconstructionCoarseCells = 0;  // cells of reconstructCoarseSpacing kept whole
   uint64_t secondaryRays = 0;  // reflection and refraction
   uint64_t aaPixels = 0;       // pixels re-sampled by adaptive antialiasing
+  uint64_t aaSeamPixels = 0;   // of them, those flagged across tile borders (seamPixels)
   uint64_t aaSubSamples = 0;   // their extra camera rays (also in primaryRays)
   lightcuts::EvalStats eval;
   ReferenceStats reference;
