@@ -97,17 +97,9 @@ int reconstructCoarseSpacing(const std::string& option, int spacing) {
   return c;
 }
 
-// --aov: extra EXR layers, by name, with their channels.
-struct AovKind {
-  const char* name;
-  std::vector<const char*> channels;
-};
-const std::vector<AovKind> kAovs = {{"albedo", {"R", "G", "B"}},
-                                    {"normal", {"X", "Y", "Z"}},
-                                    {"depth", {"Z"}},
-                                    {"cut", {"Y"}},
-                                    {"shadow_rays", {"Y"}},
-                                    {"samples", {"Y"}}};
+// --aov: extra EXR layers, by name (their channels: aovChannels). A constant array, no
+// allocation at start-up.
+constexpr const char* kAovNames[] = {"albedo", "normal", "depth", "cut", "shadow_rays", "samples"};
 
 std::vector<std::string> parseAovs(const std::string& list) {
   std::vector<std::string> out;
@@ -116,7 +108,7 @@ std::vector<std::string> parseAovs(const std::string& list) {
     size_t comma = list.find(',', start);
     std::string name = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     bool known = false;
-    for (const AovKind& k : kAovs) known = known || name == k.name;
+    for (const char* k : kAovNames) known = known || name == k;
     if (!known)
       throw Error(fmt::format("--aov: unknown output {} (use albedo, normal, depth, cut, shadow_rays, samples, "
                               "comma-separated)",
