@@ -89,13 +89,12 @@ struct SubSampleSums {
 
 float dist2(const Vec2& a, const Vec2& b) { return (a.x - b.x) * (a.x - b.x) + (a.y - b.y) * (a.y - b.y); }
 
-
 // A diffuse texture on a purely diffuse material (no specular, mirror or glass): its
 // sub-samples share shading like a plain surface's, each taking the shaded one's light scaled
 // by its own texel (the ratio of diffuse colours), exact where the light is the same over
-// the cell. Shaded once per cell of the 3 x 3 grid instead of the fine grid's (a textured
-// floor in an unseen room took 8 times the 1-spp render's time at up to 49 shadings a
-// pixel, 3.6 with this). Not with a specular term: the ratio would scale the highlight by
+// the cell. Shaded once per cell of the 3 x 3 grid instead of the fine grid's (with its
+// textured floor, bench/aa_study.ray took 7.4 times its 1-spp render's time at up to 49
+// shadings a pixel, 4.8 with this). Not with a specular term: the ratio would scale the highlight by
 // the texture too (on the Roman hall's glossy mosaic, 5% of pixels moved by over 2%).
 bool textureRatio(const scene::Material& m) {
   return m.diffuse.texture && m.specular.isBlack() && m.reflective.isBlack() && m.transmissive.isBlack() &&
@@ -237,7 +236,8 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
     b.m = m;
     const int cell = std::min(2, int(b.u.x * 3)) + 3 * std::min(2, int(b.u.y * 3));
     if (m && textureRatio(*m)) {
-      // Shared by material, as the fine cells are (below), on the 3 x 3 grid.
+      // Shared by material, as the fine cells are (below: surfaces are a threshold decision
+      // that an OBJ read directly and converted may take differently), on the 3 x 3 grid.
       b.ratio = b.byMaterial = true;
       texel(hit, b.kd, b.base);
       const std::pair<int, const scene::Material*> key{cell, m};
