@@ -84,8 +84,9 @@ std::vector<char> receiveBytes(const MPI_Status& st) {
   return buf;
 }
 
-// A tile on the wire: its index, then per pixel (row by row) the colour and the cut size
-// and shadow rays (the --aov layers) as floats, then its done flags. Exact: the floats are
+// A tile on the wire: its index, then per pixel (row by row) the colour, the cut size and
+// shadow rays (the --aov layers) and the centre's luminance (for the seams) as floats, then
+// its done flags. Exact: the floats are
 // copied, not converted.
 struct PixelRecord {
   float r, g, b, cut, rays, centre;  // centre: RenderResult::centreLuminance

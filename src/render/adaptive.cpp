@@ -37,23 +37,35 @@ bool steps(const CentreSample& a, const CentreSample& c, const CentreSample& b, 
   return std::fabs(la + lb - 2 * lc) > o.aaStep * hi;
 }
 
+namespace {
+
+// Whether a pixel of centre c is flagged by its neighbours: one that disagrees, or a step
+// through c along a row, column or diagonal of three centres. nb(dx, dy) is the neighbour
+// at that offset; use(dx, dy) whether it is compared (a line when either end is).
+// flagPixels compares every neighbour of a tile's pixel, seamPixels those across a border.
+template <class Neighbour, class Use>
+bool flaggedBy(const CentreSample& c, Neighbour nb, Use use, const RenderOptions& o) {
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      if ((dx || dy) && use(dx, dy) && disagree(c, nb(dx, dy), o)) return true;
+  constexpr int kLineDx[4] = {1, 0, 1, 1}, kLineDy[4] = {0, 1, 1, -1};
+  for (int k = 0; k < 4; ++k) {
+    const int dx = kLineDx[k], dy = kLineDy[k];
+    if ((use(-dx, -dy) || use(dx, dy)) && steps(nb(-dx, -dy), c, nb(dx, dy), o)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 std::vector<uint8_t> flagPixels(const std::vector<CentreSample>& ring, int w, int h, const RenderOptions& o) {
   std::vector<uint8_t> flags(size_t(w) * size_t(h), 0);
   const int rw = w + 2;
   auto at = [&](int x, int y) -> const CentreSample& { return ring[size_t(y + 1) * size_t(rw) + size_t(x + 1)]; };
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
-      const CentreSample& c = at(x, y);
-      bool f = false;
-      for (int dy = -1; dy <= 1 && !f; ++dy)
-        for (int dx = -1; dx <= 1 && !f; ++dx)
-          if (dx || dy) f = disagree(c, at(x + dx, y + dy), o);
-      // A step through the pixel along a row, column or diagonal of three centres.
-      for (int k = 0; k < 4 && !f; ++k) {
-        const int dx = k == 1 ? 0 : 1, dy = k == 0 ? 0 : (k == 3 ? -1 : 1);
-        f = steps(at(x - dx, y - dy), c, at(x + dx, y + dy), o);
-      }
-      flags[size_t(y) * size_t(w) + size_t(x)] = f;
+      auto nb = [&](int dx, int dy) -> const CentreSample& { return at(x + dx, y + dy); };
+      flags[size_t(y) * size_t(w) + size_t(x)] = flaggedBy(at(x, y), nb, [](int, int) { return true; }, o);
     }
   return flags;
 }
@@ -423,33 +435,24 @@ std::vector<std::pair<int, int>> seamPixels(const RenderResult& res, const Rende
   // The centres' luminance, as the tiles compared it: the flags do not depend on what the
   // re-sampled neighbours came to (nor on --aa-samples).
   auto lum = [&](int x, int y) {
-    CentreSample c;
+    CentreSample c;  // shape -1 on both sides: only luminance is compared here
+    if (x < 0 || y < 0 || x >= W || y >= H) {
+      c.shape = -2;  // outside the image: never disagrees, no luminance
+      return c;
+    }
     c.known = true;
     c.luminance = res.centreLuminance[size_t(y) * size_t(W) + size_t(x)];
     return c;
   };
-  auto inImage = [&](int x, int y) { return x >= 0 && y >= 0 && x < W && y < H; };
   for (int y = 0; y < H; ++y)
     for (int x = 0; x < W; ++x) {
-      const int tx = x % tile, ty = y % tile;
-      if (tx != 0 && tx != tile - 1 && ty != 0 && ty != tile - 1) continue;  // not on a border
+      const int inX = x % tile, inY = y % tile;
+      if (inX != 0 && inX != tile - 1 && inY != 0 && inY != tile - 1) continue;  // not on a border
       if (res.aaFlagged[size_t(y) * size_t(W) + size_t(x)]) continue;
-      const int tile0 = x / tile, tile1 = y / tile;
-      auto across = [&](int X, int Y) { return X / tile != tile0 || Y / tile != tile1; };
-      const CentreSample c = lum(x, y);
-      bool f = false;
-      // Contrast with a neighbour in another tile (shape and normal were compared there).
-      for (int dy = -1; dy <= 1 && !f; ++dy)
-        for (int dx = -1; dx <= 1 && !f; ++dx)
-          if ((dx || dy) && inImage(x + dx, y + dy) && across(x + dx, y + dy)) f = disagree(c, lum(x + dx, y + dy), o);
-      // A step along a line of three with an end in another tile.
-      for (int k = 0; k < 4 && !f; ++k) {
-        const int dx = k == 1 ? 0 : 1, dy = k == 0 ? 0 : (k == 3 ? -1 : 1);
-        const int ax = x - dx, ay = y - dy, bx = x + dx, by = y + dy;
-        if (inImage(ax, ay) && inImage(bx, by) && (across(ax, ay) || across(bx, by)))
-          f = steps(lum(ax, ay), c, lum(bx, by), o);
-      }
-      if (f) out.emplace_back(x, y);
+      // Only neighbours in another tile: shape and normal were compared there already.
+      auto across = [&](int dx, int dy) { return (x + dx) / tile != x / tile || (y + dy) / tile != y / tile; };
+      auto nb = [&](int dx, int dy) { return lum(x + dx, y + dy); };
+      if (flaggedBy(lum(x, y), nb, across, o)) out.emplace_back(x, y);
     }
   return out;
 }

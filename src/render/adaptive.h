@@ -68,9 +68,10 @@ void adaptiveTile(const scene::Scene& scene, const lightcuts::LightEvaluator& ev
 // rendered yet), so the pixels on tile borders are compared with their neighbours across
 // them too, contrast and steps alike, on their centres' luminance (res.centreLuminance).
 // The pixels this flags (not flagged already), in row order: the list depends on the
-// finished tiles alone, not on their order or on --aa-samples. Without it, a shadow or texture edge along a border was
-// left jagged (on an unseen room at 256², 55% of the unflagged contrast edges over 2% lay on
-// borders of 16-pixel tiles, against 23% of the pixels).
+// finished tiles alone, not on their order or on --aa-samples. Without it, a shadow or
+// texture edge along a border was left jagged (on an unseen room at 256², 55% of the
+// unflagged contrast edges over 2% lay on borders of 16-pixel tiles, against 23% of the
+// pixels).
 std::vector<std::pair<int, int>> seamPixels(const RenderResult& res, const RenderOptions& o, int tile);
 
 // Re-samples pixel (x, y) on the g x g grid and stores it in `res` (flagged), counting in
