@@ -48,6 +48,7 @@ EXTRA = [
     ("scenes/cornell_box.ray", "vpl-object", ["--vpl-normalize", "object", "--vpls", "2000"], None),
     ("scenes/cornell_box.ray", "probes-off-walter",
      ["--visibility-probes", "off", "--cut-criterion", "walter", "--gi", "off", "--aa", "off"], None),
+    ("scenes/cornell_box.ray", "clear-off", ["--clear-clusters", "off", "--aa", "off"], None),
     ("scenes/green_light_emitter.ray", "error-floor0", ["--error-floor", "0", "--error", "0.05"], None),
     # The named values other than the defaults, aliases among them.
     ("scenes/cornell_box.ray", "course-tree-omni",

@@ -34,6 +34,7 @@ struct RenderArgs {
   lightcuts::CutCriterion criterion = lightcuts::CutOptions{}.criterion;
   lightcuts::Estimator estimator = lightcuts::CutOptions{}.estimator;
   bool visibilityProbes = lightcuts::CutOptions{}.visibilityProbes;
+  bool clearClusters = lightcuts::CutOptions{}.clearClusters;
   std::string cutHeatmap;
   int referencePixels = 0;
   std::string errorFloor = "auto";

@@ -277,7 +277,7 @@ void resolveImageSize(RenderArgs& a, const io::CameraDesc& cam) {
 void buildEvaluator(const RenderArgs& a, RenderSetup& s) {
   const scene::Scene& scene = *s.ls.scene;
   s.tb.sceneDiagonal = scene.bounds().diagonal();
-  lightcuts::CutOptions co{s.error, a.maxCut, a.criterion, a.estimator, a.visibilityProbes};
+  lightcuts::CutOptions co{s.error, a.maxCut, a.criterion, a.estimator, a.visibilityProbes, a.clearClusters};
   co.stochasticCut = a.stochasticCut;
   co.seed = a.seed;
   if (s.method == lightcuts::Method::Brute) {
@@ -636,6 +636,13 @@ void addRenderCommand(CLI::App& app) {
             fmt::format("Lightcuts: before refining a cluster whose representative is hidden, test the corners of "
                         "its box; when one convex object hides them all, the cluster stays in the cut as hidden "
                         "(on) or not (off, as published); default {}", switchName(d.visibilityProbes)))
+      ->group(cuts);
+  addSwitch(*c, "--clear-clusters", a->clearClusters,
+            fmt::format("Lightcuts: test a cluster whose representative is visible for being visible as a whole, "
+                        "without rays (every surface's bounding volume apart from the hull of the point and the "
+                        "cluster); such clusters are refined without shadow rays and carry no visibility error "
+                        "(on) or every representative casts its ray (off, as published); default {}",
+                        switchName(d.clearClusters)))
       ->group(cuts);
   c->add_option("--reference-pixels", a->referencePixels,
                 fmt::format("Also run brute force at K pixels: report the measured error and the estimated "

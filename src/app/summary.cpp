@@ -52,6 +52,8 @@ void forEachEvalCounter(S& s, F&& f) {
   f("probe_rays", s.probeRays);
   f("occluded_rays", s.occludedRays);
   f("hidden_clusters", s.hiddenClusters);
+  f("clear_tests", s.clearTests);
+  f("cleared_clusters", s.clearClusters);
   f("group_probes", s.groupProbes);
   f("failed_group_probes", s.failedGroupProbes);
   f("traced_rays", s.tracedRays);
@@ -170,6 +172,9 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["probe_rays"] = es.probeRays;
   j["occluded_shadow_rays"] = es.occludedRays;
   j["hidden_clusters"] = es.hiddenClusters;
+  j["clear_clusters"] = switchName(a.clearClusters);
+  j["clear_tests"] = es.clearTests;
+  j["cleared_clusters"] = es.clearClusters;
   j["group_probes"] = es.groupProbes;
   j["failed_group_probes"] = es.failedGroupProbes;
   j["reconstruct_spacing"] = ro.reconstructSpacing;

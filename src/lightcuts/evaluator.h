@@ -89,6 +89,12 @@ struct CutOptions {
   // cluster is provably hidden (Visibility::trace) and stays in the cut as 0, with no
   // error, instead of being refined down to every light (the umbra of an emitter).
   bool visibilityProbes = true;
+  // --clear-clusters: a cluster of 16 lights or more whose representative is visible is
+  // tested for being visible as a whole without rays (Visibility::boxClear: every surface's
+  // bounding volume is apart from the hull of the point and the cluster's box); when it is,
+  // the cluster and every cluster under it are known unoccluded: refining them casts no
+  // shadow rays, and their error is their unshadowed bounds' alone.
+  bool clearClusters = true;
   // --method stochastic: clusters in the cut, each giving one light drawn at random
   // (stochastic.cpp); its seed (render --seed).
   int stochasticCut = 64;

@@ -48,6 +48,12 @@ class Visibility {
     tHit = 0;
     return v;
   }
+  // Whether every shadow ray toward a point of the box [lo, hi] (a cluster's light
+  // positions) is certainly unblocked, without tracing any: a conservative test, false
+  // when it cannot tell (and by default). `hint` is the implementation's to keep between
+  // calls (what stopped an earlier test, tried first); kNoHint to begin with.
+  static constexpr uint32_t kNoHint = ~0u;
+  virtual bool boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) { return false; }
 };
 
 // M * G of one light per unit intensity, without visibility. Returns false when the

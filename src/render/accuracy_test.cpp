@@ -108,6 +108,36 @@ TEST(Accuracy, LightcutsWithinTwoPercentInARoomOfPartlyHiddenClusters) {
   EXPECT_LE(m.fraction_over_threshold, 0.002) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
 }
 
+// Clusters proven clear (Visibility::boxClear) are refined without rays. With a zero
+// threshold every cluster is refined down to its lights, so the image must be brute
+// force's: any cluster wrongly called clear would show there as light through a wall.
+// At the default threshold they save rays at the same accuracy.
+TEST(Accuracy, ClearClustersAreExactAndSaveShadowRays) {
+  auto s = scene::Scene::build(io::parseRayString(randomRoom(778, 1500), "room.ray", "."));
+  auto brute = lightcuts::makeBruteForce(s->lights());
+  lightcuts::LightForest forest = lightcuts::buildLightForest(s->lights());
+  lightcuts::CutOptions exact;
+  exact.errorRatio = 0;
+  exact.maxCut = 1 << 20;
+  auto lcExact = lightcuts::makeLightcuts(s->lights(), forest, exact);
+  RenderResult ref = renderWith(*s, *brute, 24);
+  RenderResult test = renderWith(*s, *lcExact, 24);
+  EXPECT_GT(test.stats.eval.clearClusters, 100u);
+  for (size_t i = 0; i < ref.image.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      ASSERT_NEAR(test.image.pixels[i][c], ref.image.pixels[i][c], 1e-4f * (ref.image.pixels[i][c] + 1e-3f)) << i;
+
+  lightcuts::CutOptions off;
+  off.clearClusters = false;
+  auto lcOn = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
+  auto lcOff = lightcuts::makeLightcuts(s->lights(), forest, off);
+  RenderResult big = renderWith(*s, *brute, 48);
+  RenderResult on = renderWith(*s, *lcOn, 48), without = renderWith(*s, *lcOff, 48);
+  EXPECT_EQ(without.stats.eval.clearTests, 0u);
+  EXPECT_LT(double(on.stats.eval.shadowRays), 0.8 * double(without.stats.eval.shadowRays));
+  EXPECT_LE(io::compareImages(big.image, on.image).fraction_over_threshold, 0.002);
+}
+
 TEST(Accuracy, LightcutsWithinTwoPercentOfBruteForceOnTheCornellBox) {
   Loaded l = loadCornell();
   const scene::Scene& s = *l.scene;

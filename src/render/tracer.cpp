@@ -63,6 +63,18 @@ Color ShadowRays::trace(const Vec3& wi, float dist, int& blocker, float& tHit) {
   });
 }
 
+// Rays toward a box in front of the point's surface leave from p' = p + ng eps (and a step
+// along the ray) and end 2 eps short of the light moved by ng eps (origin()): each is part
+// of the segment from p' toward a point of the moved box, ending 2 eps before it. The
+// convex shape the point lies on (hit from outside) is behind its tangent plane, which the
+// box is in front of: no ray re-enters it.
+bool ShadowRays::boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) {
+  const Vec3 c = (lo + hi) * 0.5f, h = (hi - lo) * 0.5f;
+  if (!(dot(ng_, c - p_) - dot(vabs(ng_), h) > 2 * eps_)) return false;
+  const Vec3 off = ng_ * eps_;
+  return scene_.occluders().clear(p_ + off, lo + off, hi + off, 0.1f * eps_, 2 * eps_, ownShape_, &hint);
+}
+
 // The ray's origin, off the surface on the light's side and a step toward the light,
 // and its length to just short of the light. The step matters on an edge where two
 // surfaces meet (a room's corner): the point lies in the other surface's plane, and

@@ -28,9 +28,11 @@ class ShadowRays final : public lightcuts::Visibility {
   static constexpr uint32_t kTimedRayOdds = 64;
   static constexpr int64_t kMaxTimedRayNs = 50'000;
   ShadowRays(const scene::Scene& s, const scene::Hit& h, lightcuts::EvalStats* stats = nullptr)
-      : scene_(s), p_(h.p), ng_(h.ng), eps_(s.epsilon()), stats_(stats) {}
+      : scene_(s), p_(h.p), ng_(h.ng), eps_(s.epsilon()), stats_(stats),
+        ownShape_(h.shape >= 0 && h.frontFace && s.isConvex(h.shape) ? h.shape : -1) {}
   Color operator()(const Vec3& wi, float dist) override;
   Color trace(const Vec3& wi, float dist, int& blocker, float& tHit) override;
+  bool boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) override;
 
  private:
   Vec3 origin(const Vec3& wi, float dist, float& tmax) const;
@@ -41,6 +43,7 @@ class ShadowRays final : public lightcuts::Visibility {
   Vec3 p_, ng_;
   float eps_;
   lightcuts::EvalStats* stats_;
+  int ownShape_;  // the convex shape the point lies on, hit from outside (-1: none)
 };
 
 // What lights a primary hit (depth 0) in place of a full evaluation: under reconstruction

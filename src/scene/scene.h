@@ -16,6 +16,7 @@
 #include "scene/environment.h"
 #include "core/light.h"
 #include "scene/material.h"
+#include "scene/occluders.h"
 #include "scene/shape.h"
 
 namespace lc::scene {
@@ -76,6 +77,8 @@ class Scene {
   bool isConvex(int shape) const { return convex_[size_t(shape)] != 0; }
   // Whether light can pass through some part of a shape (a transmissive material).
   bool isTransmissive(int shape) const { return shadowsThroughGlass_ && transmissive_[size_t(shape)] != 0; }
+  // Every surface as convex pieces, for proving a set of segments clear (occluders.h).
+  const OccluderIndex& occluders() const { return occluders_; }
 
   // Material values at a hit (textures looked up, per-vertex materials blended).
   ShadingMaterial shadingMaterial(const Hit& hit) const;
@@ -126,6 +129,7 @@ class Scene {
   bool shadowsThroughGlass_ = true;
   std::vector<uint8_t> convex_;        // per shape
   std::vector<uint8_t> transmissive_;  // per shape
+  OccluderIndex occluders_;
   RTCDevice device_ = nullptr;
   RTCScene rtc_ = nullptr;
 };

@@ -1,0 +1,283 @@
+#include "scene/occluders.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace lc::scene {
+
+using io::ShapeKind;
+
+namespace detail {
+
+constexpr uint32_t kLeafPieces = 4;
+
+// Pads an extent for the rounding of the float values it was computed from.
+void pad(float& lo, float& hi) {
+  float p = (std::fabs(lo) + std::fabs(hi) + (hi - lo)) * 1e-6f;
+  lo -= p;
+  hi += p;
+}
+
+Bounds3 padded(Bounds3 b) {
+  Vec3 p = (vabs(b.lo) + vabs(b.hi) + b.extent()) * 1e-6f;
+  b.lo -= p;
+  b.hi += p;
+  return b;
+}
+
+// The segments from an apex toward the points of a box, each ending `shortfall` before
+// its point, lie in two convex hulls: of the apex and the box, and of the apex and the
+// segments' ends (the box moved back toward the apex by up to `shortfall`). A piece apart
+// from either is apart from the segments; the second sets apart the surface a light lies
+// on, which the first only touches.
+struct Hull {
+  Vec3 apex, c, h;  // the box's centre and half extent
+  Vec3 lo, hi;      // the bounding box of both hulls' intersection
+  float margin, shortfall;
+  float dMin, dMax;  // distances from the apex to the box
+  // The cone from the apex that holds the box, set up when first needed (most pieces are
+  // set apart by the bounding boxes alone): none when the apex is near or in the box.
+  mutable int cone = -1;  // -1 not set up, 0 none, 1 set
+  mutable Vec3 u, v, w, au, av, aw;
+  mutable float cosAngle = 1;
+
+  Hull(const Vec3& a, const Vec3& blo, const Vec3& bhi, float m, float s)
+      : apex(a), c((blo + bhi) * 0.5f), h((bhi - blo) * 0.5f), margin(m), shortfall(s) {
+    Vec3 near = vmax(vmax(blo - a, a - bhi), Vec3(0.0f));
+    dMin = length(near);
+    dMax = length(vmax(vabs(blo - a), vabs(bhi - a)));
+    for (int k = 0; k < 3; ++k) {
+      Vec3 n(0.0f);
+      n[k] = 1;
+      float elo, ehi;
+      extent(n, elo, ehi);
+      lo[k] = elo;
+      hi[k] = ehi;
+    }
+  }
+  // The range of n . wi over the unit directions wi from the apex to the box.
+  void directionRange(const Vec3& n, float& lo, float& hi) const {
+    if (!(dMin > 0)) {
+      lo = -1;
+      hi = 1;
+      return;
+    }
+    float qc = dot(n, c - apex), qh = dot(vabs(n), h);
+    float q0 = qc - qh, q1 = qc + qh;
+    lo = std::max(-1.0f, q0 < 0 ? q0 / dMin : q0 / dMax);
+    hi = std::min(1.0f, q1 < 0 ? q1 / dMax : q1 / dMin);
+  }
+  // The extent along unit axis n of the two hulls' intersection.
+  void extent(const Vec3& n, float& elo, float& ehi) const {
+    float a = dot(n, apex), bc = dot(n, c), bh = dot(vabs(n), h);
+    float blo = bc - bh, bhi = bc + bh;
+    if (shortfall > 0) {
+      float wlo, whi;
+      directionRange(n, wlo, whi);
+      // An end is its point less shortfall * wi: along n, within these.
+      blo = std::max(blo, bc - bh - shortfall * whi);
+      bhi = std::min(bhi, bc + bh - shortfall * wlo);
+    }
+    elo = std::min(a, blo);
+    ehi = std::max(a, bhi);
+  }
+  bool setUpCone() const {
+    Vec3 d = c - apex;
+    float dist = length(d), r = length(h) + margin;
+    cone = 0;
+    if (!(dist > 2 * r)) return false;  // a wide cone would rarely set anything apart
+    w = d / dist;
+    orthonormalBasis(w, u, v);
+    au = vabs(u);
+    av = vabs(v);
+    aw = vabs(w);
+    float s = r / dist;
+    cosAngle = std::sqrt(1 - s * s);
+    cone = 1;
+    return true;
+  }
+  bool boxApart(const Bounds3& b) const {
+    if (b.hi.x < lo.x - margin || b.lo.x > hi.x + margin || b.hi.y < lo.y - margin || b.lo.y > hi.y + margin ||
+        b.hi.z < lo.z - margin || b.lo.z > hi.z + margin)
+      return true;
+    if (cone == 0 || (cone < 0 && !setUpCone())) return false;
+    // The largest cosine between w and a vector from the apex into b (bounds.h's
+    // cosBoundBox): below the cone's, b lies outside the cone and so outside the hull.
+    Vec3 qc = (b.lo + b.hi) * 0.5f - apex, qh = (b.hi - b.lo) * 0.5f;
+    float mz = dot(qc, w) + dot(aw, qh);
+    if (mz < 0) return true;
+    float ax = std::fabs(dot(qc, u)) - dot(au, qh), ay = std::fabs(dot(qc, v)) - dot(av, qh);
+    float x2 = ax > 0 ? ax * ax : 0, y2 = ay > 0 ? ay * ay : 0;
+    return mz < cosAngle * std::sqrt(x2 + y2 + mz * mz);
+  }
+  // Whether unit axis n separates the hulls from the extent [plo, phi] along n.
+  bool axisApart(const Vec3& n, float plo, float phi) const {
+    float elo, ehi;
+    extent(n, elo, ehi);
+    return ehi < plo - margin || elo > phi + margin;
+  }
+};
+
+}  // namespace detail
+
+using detail::Hull;
+using detail::kLeafPieces;
+using detail::pad;
+using detail::padded;
+
+OccluderIndex::OccluderIndex(const std::vector<Shape>& shapes, const std::vector<Mesh>& meshes) {
+  for (size_t si = 0; si < shapes.size(); ++si) {
+    const Shape& s = shapes[si];
+    if (s.kind == ShapeKind::Mesh) {
+      const Mesh& m = meshes[size_t(s.mesh)];
+      for (const auto& tri : m.triangles) {
+        const Vec3 &p0 = m.positions[size_t(tri[0])], &p1 = m.positions[size_t(tri[1])],
+                   &p2 = m.positions[size_t(tri[2])];
+        Piece p;
+        p.shape = int(si);
+        p.box = Bounds3(p0, p1);
+        p.box.extend(p2);
+        p.box = padded(p.box);
+        Vec3d e1 = Vec3d(p1) - Vec3d(p0), e2 = Vec3d(p2) - Vec3d(p0);
+        Vec3d n(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
+        double len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
+        if (len > 0 && std::isfinite(len)) {
+          Vec3 nf = Vec3(float(n.x / len), float(n.y / len), float(n.z / len));
+          float d0 = dot(nf, p0), d1 = dot(nf, p1), d2 = dot(nf, p2);
+          p.axes = 1;
+          p.axis[0] = nf;
+          p.lo[0] = std::min({d0, d1, d2});
+          p.hi[0] = std::max({d0, d1, d2});
+          pad(p.lo[0], p.hi[0]);
+        }
+        pieces_.push_back(p);
+      }
+      continue;
+    }
+    Piece p;
+    p.shape = int(si);
+    p.box = quadricBounds(s);
+    // The shape lies in its local bounds: along each local axis (a row of toLocal, the
+    // normal of the local planes x, y or z = const), within the bounds' corners' extent.
+    Bounds3 local;
+    switch (s.kind) {
+      case ShapeKind::Sphere: local = Bounds3(Vec3(-1.0f), Vec3(1.0f)); break;
+      case ShapeKind::Box: local = Bounds3(Vec3(-0.5f), Vec3(0.5f)); break;
+      case ShapeKind::Square: local = Bounds3(Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, 0.5f, 0)); break;
+      case ShapeKind::Cylinder: local = Bounds3(Vec3(-1, -1, 0), Vec3(1, 1, 1)); break;
+      case ShapeKind::Cone: {
+        float r = std::max(std::fabs(s.bottomRadius), std::fabs(s.topRadius));
+        local = Bounds3(Vec3(-r, -r, 0), Vec3(r, r, s.height));
+        break;
+      }
+      case ShapeKind::Mesh: break;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const auto& row = s.toLocal.m[size_t(k)];
+      double len = std::sqrt(row[0] * row[0] + row[1] * row[1] + row[2] * row[2]);
+      if (!(len > 0) || !std::isfinite(len)) continue;
+      Vec3 n(float(row[0] / len), float(row[1] / len), float(row[2] / len));
+      float lo = kInf, hi = -kInf;
+      for (int i = 0; i < 8; ++i) {
+        Vec3 corner((i & 1) ? local.hi.x : local.lo.x, (i & 2) ? local.hi.y : local.lo.y,
+                    (i & 4) ? local.hi.z : local.lo.z);
+        float d = dot(n, s.toWorld.point(corner));
+        lo = std::min(lo, d);
+        hi = std::max(hi, d);
+      }
+      pad(lo, hi);
+      p.axis[p.axes] = n;
+      p.lo[p.axes] = lo;
+      p.hi[p.axes] = hi;
+      ++p.axes;
+    }
+    if (p.axes != 3) p.axes = 0;  // a degenerate frame: its bounding box alone
+    pieces_.push_back(p);
+  }
+  if (pieces_.empty()) return;
+  std::vector<Vec3> centres(pieces_.size());
+  for (size_t i = 0; i < pieces_.size(); ++i) centres[i] = pieces_[i].box.center();
+  nodes_.reserve(2 * pieces_.size() / kLeafPieces + 2);
+  nodes_.emplace_back();
+  build(0, 0, uint32_t(pieces_.size()), centres);
+}
+
+// Fills node `self` for pieces [begin, end): a leaf, or a split at the median centre along
+// the centres' longest axis into two children stored side by side.
+void OccluderIndex::build(uint32_t self, uint32_t begin, uint32_t end, std::vector<Vec3>& centres) {
+  Bounds3 box, cbox;
+  for (uint32_t i = begin; i < end; ++i) {
+    box.extend(pieces_[i].box);
+    cbox.extend(centres[i]);
+  }
+  nodes_[self].box = box;
+  if (end - begin <= kLeafPieces) {
+    nodes_[self].first = begin;
+    nodes_[self].count = end - begin;
+    return;
+  }
+  Vec3 e = cbox.extent();
+  int axis = e.x >= e.y && e.x >= e.z ? 0 : e.y >= e.z ? 1 : 2;
+  uint32_t mid = begin + (end - begin) / 2;
+  std::vector<uint32_t> order(end - begin);
+  for (uint32_t i = 0; i < order.size(); ++i) order[i] = begin + i;
+  std::nth_element(order.begin(), order.begin() + (mid - begin), order.end(), [&](uint32_t a, uint32_t b) {
+    float ca = centres[a][axis], cb = centres[b][axis];
+    return ca < cb || (ca == cb && a < b);
+  });
+  std::vector<Piece> ps(order.size());
+  std::vector<Vec3> cs(order.size());
+  for (size_t i = 0; i < order.size(); ++i) {
+    ps[i] = pieces_[order[i]];
+    cs[i] = centres[order[i]];
+  }
+  std::copy(ps.begin(), ps.end(), pieces_.begin() + begin);
+  std::copy(cs.begin(), cs.end(), centres.begin() + begin);
+  const uint32_t first = uint32_t(nodes_.size());
+  nodes_.emplace_back();
+  nodes_.emplace_back();
+  nodes_[self].first = first;
+  nodes_[self].count = 0;
+  build(first, begin, mid, centres);
+  build(first + 1, mid, end, centres);
+}
+
+bool OccluderIndex::pieceApart(const Hull& hull, uint32_t i, int skip) const {
+  const Piece& p = pieces_[i];
+  if (p.shape == skip || hull.boxApart(p.box)) return true;
+  for (int k = 0; k < p.axes; ++k)
+    if (hull.axisApart(p.axis[k], p.lo[k], p.hi[k])) return true;
+  return false;
+}
+
+bool OccluderIndex::clear(const Vec3& apex, const Vec3& lo, const Vec3& hi, float margin, float shortfall,
+                          int skip, uint32_t* hint) const {
+  if (nodes_.empty()) return true;
+  const Hull hull(apex, lo, hi, margin, shortfall);
+  // The piece that stopped the last query is often in the way of this one too (a pillar
+  // between the point and a group of clusters): tried first, a "no" costs one piece.
+  if (hint && *hint < pieces_.size() && !pieceApart(hull, *hint, skip)) return false;
+  uint32_t stack[64];
+  int top = 0, visits = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[stack[--top]];
+    if (++visits > kMaxVisits) return false;
+    if (hull.boxApart(n.box)) continue;
+    if (n.count == 0) {
+      if (top + 2 > 64) return false;
+      stack[top++] = n.first + 1;
+      stack[top++] = n.first;
+      continue;
+    }
+    for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+      if (pieceApart(hull, i, skip)) continue;
+      if (hint) *hint = i;
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace lc::scene

@@ -1,0 +1,160 @@
+// OccluderIndex: a "clear" answer must hold for every segment (checked with Embree against
+// random scenes of every shape kind), and the cases it exists for must come out clear.
+#include "scene/occluders.h"
+
+#include <gtest/gtest.h>
+
+#include "core/rng.h"
+#include "scene/scene.h"
+
+namespace lc::scene {
+namespace {
+
+using io::ShapeKind;
+
+io::ObjectDesc object(ShapeKind kind, const Mat4& m) {
+  io::ObjectDesc o;
+  o.kind = kind;
+  o.transform = m;
+  o.height = 1.5f;
+  o.bottomRadius = 0.8f;
+  o.topRadius = 0.3f;
+  return o;
+}
+
+Vec3 uniformIn(Rng& rng, const Vec3& lo, const Vec3& hi) {
+  return lo + (hi - lo) * Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+}
+
+// Random scenes: a few shapes of every kind under random rotations and scales, and a
+// mesh of random triangles; random apexes and boxes. Every "clear" is checked with rays
+// to the box's corners and random points in it; enough answers must be "clear" for the
+// check to mean something, and enough "not clear" for the test to discriminate.
+TEST(OccluderIndex, ClearSegmentsMeetNoSurface) {
+  Rng rng(21, 0);
+  int clear = 0, blocked = 0;
+  for (int sceneIndex = 0; sceneIndex < 12; ++sceneIndex) {
+    io::SceneDesc d;
+    d.materials.emplace_back();
+    for (int k = 0; k < 6; ++k) {
+      Vec3 c = uniformIn(rng, Vec3(-4.0f), Vec3(4.0f));
+      Mat4 m = Mat4::translate(c.x, c.y, c.z) *
+               Mat4::rotate(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5, 6.28 * rng.uniform()) *
+               Mat4::scale(0.3 + rng.uniform(), 0.3 + rng.uniform(), 0.3 + rng.uniform());
+      d.objects.push_back(object(ShapeKind(k % 5), m));
+    }
+    io::MeshDesc mesh;
+    for (int t = 0; t < 6; ++t) {
+      Vec3 c = uniformIn(rng, Vec3(-4.0f), Vec3(4.0f));
+      for (int v = 0; v < 3; ++v) mesh.points.push_back(c + uniformIn(rng, Vec3(-1.0f), Vec3(1.0f)));
+      mesh.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+    }
+    d.meshes.push_back(mesh);
+    io::ObjectDesc mo = object(ShapeKind::Mesh, Mat4::identity());
+    mo.mesh = 0;
+    d.objects.push_back(mo);
+    auto s = Scene::build(d);
+    const OccluderIndex& index = s->occluders();
+    ASSERT_EQ(index.pieceCount(), 6u + 6u);
+    for (int q = 0; q < 300; ++q) {
+      Vec3 apex = uniformIn(rng, Vec3(-6.0f), Vec3(6.0f));
+      Vec3 c = uniformIn(rng, Vec3(-6.0f), Vec3(6.0f)), h = uniformIn(rng, Vec3(0.0f), Vec3(0.6f));
+      const float shortfall = q % 2 ? 0.0f : 0.01f;
+      if (!index.clear(apex, c - h, c + h, 1e-5f, shortfall)) {
+        ++blocked;
+        continue;
+      }
+      ++clear;
+      for (int k = 0; k < 72; ++k) {
+        Vec3 target = k < 8 ? Vec3((k & 1) ? c.x + h.x : c.x - h.x, (k & 2) ? c.y + h.y : c.y - h.y,
+                                   (k & 4) ? c.z + h.z : c.z - h.z)
+                            : uniformIn(rng, c - h, c + h);
+        Vec3 dir = target - apex;
+        float dist = length(dir);
+        if (!(dist > shortfall)) continue;
+        ASSERT_FALSE(s->occluded(apex, dir / dist, dist - shortfall))
+            << "scene " << sceneIndex << " query " << q << ": called clear, but a segment meets a surface";
+      }
+    }
+  }
+  EXPECT_GT(clear, 300);
+  EXPECT_GT(blocked, 300);
+}
+
+// A room of thin boxes with a pillar: from a point on the floor a box of lights under the
+// ceiling in the open is clear; one behind the pillar is not.
+TEST(OccluderIndex, RoomInteriorIsClearPillarIsNot) {
+  io::SceneDesc d;
+  d.materials.emplace_back();
+  auto slab = [&](Vec3 c, Vec3 size) {
+    d.objects.push_back(object(ShapeKind::Box, Mat4::translate(c.x, c.y, c.z) * Mat4::scale(size.x, size.y, size.z)));
+  };
+  slab({0, -0.05f, 0}, {10, 0.1f, 10});  // floor, top at y = 0
+  slab({0, 4.05f, 0}, {10, 0.1f, 10});   // ceiling
+  slab({-5.05f, 2, 0}, {0.1f, 4, 10});
+  slab({5.05f, 2, 0}, {0.1f, 4, 10});
+  slab({0, 2, -5.05f}, {10, 4, 0.1f});
+  slab({0, 2, 5.05f}, {10, 4, 0.1f});
+  slab({2, 2, 0}, {0.5f, 4, 0.5f});  // a pillar
+  auto s = Scene::build(d);
+  const float eps = s->epsilon();
+  const Vec3 apex(0, eps, 0);  // just above the floor
+  EXPECT_TRUE(s->occluders().clear(apex, Vec3(-3, 3, -3), Vec3(-2, 3.5f, -2), 0.1f * eps));
+  EXPECT_FALSE(s->occluders().clear(apex, Vec3(3.5f, 1, -0.5f), Vec3(4.5f, 2, 0.5f), 0.1f * eps));
+  // A box that reaches into the ceiling is not clear.
+  EXPECT_FALSE(s->occluders().clear(apex, Vec3(-3, 3, -3), Vec3(-2, 4.2f, -2), 0.1f * eps));
+}
+
+// Lights on a surface (VPLs, an emitter's samples): the segments end short of them, so the
+// surface they lie on is apart from the segments though the box touches it.
+TEST(OccluderIndex, ShortfallSetsApartTheSurfaceTheLightsLieOn) {
+  io::SceneDesc d;
+  d.materials.emplace_back();
+  // A square in the plane y = 3 (local z = 0 turned to face -y), 4 x 4.
+  d.objects.push_back(object(ShapeKind::Square, Mat4::translate(0, 3, 0) * Mat4::rotate(1, 0, 0, 1.5707963) *
+                                                     Mat4::scale(4, 4, 1)));
+  auto s = Scene::build(d);
+  const Vec3 apex(0, 0, 0), lo(-1, 3, -1), hi(1, 3, 1);
+  EXPECT_FALSE(s->occluders().clear(apex, lo, hi, 1e-5f, 0.0f));
+  EXPECT_TRUE(s->occluders().clear(apex, lo, hi, 1e-5f, 1e-3f));
+  // From either side: a box reaching behind the surface by more than the shortfall is not
+  // clear, one in front of it is.
+  const Vec3 below(0, 0, 0), above(0, 6, 0);
+  EXPECT_FALSE(s->occluders().clear(below, Vec3(-1, 3, -1), Vec3(1, 3.01f, 1), 1e-5f, 1e-3f));
+  EXPECT_TRUE(s->occluders().clear(below, Vec3(-1, 2.99f, -1), Vec3(1, 3, 1), 1e-5f, 1e-3f));
+  EXPECT_FALSE(s->occluders().clear(above, Vec3(-1, 2.99f, -1), Vec3(1, 3, 1), 1e-5f, 1e-3f));
+  EXPECT_TRUE(s->occluders().clear(above, Vec3(-1, 3, -1), Vec3(1, 3.01f, 1), 1e-5f, 1e-3f));
+}
+
+// The shape the apex lies on may be left out by the caller (a convex shape, the box in
+// front of its tangent plane); without that the point's own sphere stands in the way.
+TEST(OccluderIndex, SkipLeavesOutTheApexsOwnShape) {
+  io::SceneDesc d;
+  d.materials.emplace_back();
+  d.objects.push_back(object(ShapeKind::Sphere, Mat4::identity()));
+  auto s = Scene::build(d);
+  // On the sphere at 45 degrees, inside its bounding cube; the box along the normal.
+  const Vec3 apex(0.7072f, 0.7072f, 0), lo(2.7f, 2.7f, -0.3f), hi(3.3f, 3.3f, 0.3f);
+  EXPECT_FALSE(s->occluders().clear(apex, lo, hi, 1e-5f));
+  EXPECT_TRUE(s->occluders().clear(apex, lo, hi, 1e-5f, 0.0f, 0));
+}
+
+// The hint: the piece that said no is remembered and tried first; answers do not change.
+TEST(OccluderIndex, HintKeepsTheBlockerAndTheAnswers) {
+  io::SceneDesc d;
+  d.materials.emplace_back();
+  for (int k = 0; k < 20; ++k)
+    d.objects.push_back(object(ShapeKind::Box, Mat4::translate(3.0 * k, 0, 0)));
+  auto s = Scene::build(d);
+  uint32_t hint = ~0u;
+  EXPECT_FALSE(s->occluders().clear(Vec3(30, 0, -5), Vec3(29.5f, -0.2f, 4), Vec3(30.5f, 0.2f, 5), 1e-5f, 0, -1, &hint));
+  EXPECT_LT(hint, s->occluders().pieceCount());
+  const uint32_t blocker = hint;
+  EXPECT_FALSE(s->occluders().clear(Vec3(30, 0, -5), Vec3(29.8f, -0.1f, 4), Vec3(30.2f, 0.1f, 5), 1e-5f, 0, -1, &hint));
+  EXPECT_EQ(hint, blocker);
+  EXPECT_TRUE(s->occluders().clear(Vec3(31.5f, 0, -5), Vec3(31.4f, -0.1f, 4), Vec3(31.6f, 0.1f, 5), 1e-5f, 0, -1,
+                                   &hint));
+}
+
+}  // namespace
+}  // namespace lc::scene
