@@ -182,7 +182,7 @@ class Lightcuts final : public LightEvaluator {
     NodeRef left, right;
     uint32_t rep, lights, pre, rightPre;  // pre: its own (the left child's is pre + 1)
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
-    uint8_t sum;      // the sum its squared spread is in: 0 sumSq, 1 sumScaled, 2 sumClear
+    bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
     bool clear;       // no surface can hide any of its lights (Visibility::boxClear)
     float hideable;   // visible: its estimate's luminance squared, in sumHideable
     uint32_t blocker;  // the hint for its boxClear test
@@ -278,10 +278,6 @@ class Lightcuts final : public LightEvaluator {
     // rate, and the others; and of the squared estimates of those whose representative is
     // visible (kHiddenSharePerBoundary).
     double sumSq = 0, sumScaled = 0, sumHideable = 0;
-    // And of those of first-order nodes known clear (Visibility::boxClear): no shadow can
-    // make their estimate err more than its own second-order error, a small part of the
-    // spread (kSmoothSpreadMin) wherever the point's shadow boundaries are.
-    double sumClear = 0;
     uint32_t refinedTested = 0, refinedSplit = 0;  // the boundary rate's counts
     const bool rss = opt_.criterion == CutCriterion::Total;
     const bool firstOrder = opt_.estimator == Estimator::FirstOrder;
@@ -350,14 +346,14 @@ class Lightcuts final : public LightEvaluator {
         // Its moments are read at the end if it stays in the cut: a miss there cost 17% of
         // the cut loop (perf, 100k point lights).
         if (fo) __builtin_prefetch(&tree.moments[ni]);
-        const uint8_t sum = !(rss && fo && !boundary) ? 0 : clear ? 2 : 1;
-        (sum == 0 ? sumSq : sum == 1 ? sumScaled : sumClear) += double(spread) * spread;
+        const bool scaled = rss && fo && !boundary;
+        (scaled ? sumScaled : sumSq) += double(spread) * spread;
         const float le = luminance(est);
         const float hideable = rss && visible && !boundary && !clear ? le * le : 0.0f;
         sumHideable += hideable;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
         nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, left, right, n.rep, n.lights(),
-                                pre, n.rightPre(pre), fo, sum, clear, hideable, blocker});
+                                pre, n.rightPre(pre), fo, scaled, clear, hideable, blocker});
       } else if (record) {
         record1(t, pre, found, false);
       }
@@ -405,14 +401,13 @@ class Lightcuts final : public LightEvaluator {
         if (!rss) break;
         const double rate = double(refinedSplit) / std::max(1u, refinedTested);
         const double w = std::clamp(kSmoothSpreadPerBoundary * rate, kSmoothSpreadMin, 1.0);
-        if (sumSq + w * w * sumScaled + kSmoothSpreadMin * kSmoothSpreadMin * sumClear +
-                kHiddenSharePerBoundary * rate * sumHideable <=
+        if (sumSq + w * w * sumScaled + kHiddenSharePerBoundary * rate * sumHideable <=
             rssFactor2 * double(limit) * limit)
           break;
       }
       heapPop(heap);
       const CutNode cn = nodes[uint32_t(top)];
-      double& sum = cn.sum == 0 ? sumSq : cn.sum == 1 ? sumScaled : sumClear;
+      double& sum = cn.scaled ? sumScaled : sumSq;
       sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
       sumHideable = std::max(0.0, sumHideable - double(cn.hideable));
       const LightTree& tree = forest_.trees[cn.tree];
@@ -426,8 +421,6 @@ class Lightcuts final : public LightEvaluator {
       }
       total -= cn.estimate;
       --cutSize;
-      ShadowResult shadows[2];
-      Color units[2];
       // A cluster whose representative is visible may be visible as a whole: then its
       // refinement casts no rays, and its sub-clusters are clear too. Tested when it is
       // about to be refined: a cluster that stays in the cut would save nothing.
@@ -441,45 +434,36 @@ class Lightcuts final : public LightEvaluator {
         stats.clearClusters += cnClear;
         (cnClear ? clearSuccesses : clearFailures) += 1;
       }
-      if (cnClear) {
-        // Known visible: the children's representatives need no rays, and the split is no
-        // shadow boundary. It counts in the boundary rate as the two rays would have: both
-        // visible (the rate's constants were measured with them counted).
-        for (uint32_t k = 0; k < 2; ++k) {
-          const NodeRef c = k ? cn.right : cn.left;
-          const uint32_t rep = tree.repOf(c);
-          shadows[k] = cn.shadow;
-          units[k] = rep == cn.rep ? cn.unit
-                                   : clearUnit(lights_.lights[rep], lights_.groups[lights_.lights[rep].group], sp,
-                                               shadows[k]);
-        }
-        refinedTested += shadows[0].found != CutVisibility::Untested && shadows[1].found != CutVisibility::Untested;
-        addNode(cn.tree, cn.left, LightNode::leftPre(cn.pre), units[0], shadows[0], false, true);
-        addNode(cn.tree, cn.right, cn.rightPre, units[1], shadows[1], false, true);
-        prefetchPending();
-        continue;
-      }
+      ShadowResult shadows[2];
+      Color units[2];
+      bool boundary = false;
       for (uint32_t k = 0; k < 2; ++k) {
         const NodeRef c = k ? cn.right : cn.left;
         const uint32_t rep = tree.repOf(c);
-        // The child that shares the parent's representative reuses its shadow ray.
-        // Only clusters that may be probed need to know what hid their representative.
+        const Light& l = lights_.lights[rep];
+        // The child that shares the parent's representative reuses its shadow ray; in a
+        // clear cluster no child needs one. Only clusters that may be probed need to know
+        // what hid their representative.
         shadows[k] = cn.shadow;
-        units[k] = rep == cn.rep ? cn.unit
-                                : shadowedUnit(lights_.lights[rep], lights_.groups[lights_.lights[rep].group], sp,
-                                               vis, stats, shadows[k],
-                                               probes && tree.lightCount(c) >= kProbeMinLights);
+        if (rep == cn.rep)
+          units[k] = cn.unit;
+        else if (cnClear)
+          units[k] = clearUnit(l, lights_.groups[l.group], sp, shadows[k]);
+        else
+          units[k] = shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, shadows[k],
+                                  probes && tree.lightCount(c) >= kProbeMinLights);
       }
-      // A shadow boundary: one child's representative is hidden, the other's not.
-      bool boundary = false;
+      // A shadow boundary: one child's representative is hidden, the other's not (never in
+      // a clear cluster, whose refinements count in the boundary rate as their rays would
+      // have: the rate's constants were measured with them counted).
       if (shadows[0].found != CutVisibility::Untested && shadows[1].found != CutVisibility::Untested) {
         auto hidden = [](CutVisibility v) { return v == CutVisibility::Occluded || v == CutVisibility::Partial; };
         boundary = hidden(shadows[0].found) != hidden(shadows[1].found);
         ++refinedTested;
         refinedSplit += boundary;
       }
-      addNode(cn.tree, cn.left, LightNode::leftPre(cn.pre), units[0], shadows[0], boundary, false, blocker);
-      addNode(cn.tree, cn.right, cn.rightPre, units[1], shadows[1], boundary, false, blocker);
+      addNode(cn.tree, cn.left, LightNode::leftPre(cn.pre), units[0], shadows[0], boundary, cnClear, blocker);
+      addNode(cn.tree, cn.right, cn.rightPre, units[1], shadows[1], boundary, cnClear, blocker);
       prefetchPending();
     }
     // The first-order estimates of the clusters left in the cut, kept within their bounds;
