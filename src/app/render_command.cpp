@@ -329,6 +329,8 @@ bool setUpRender(RenderArgs& a, Cluster* cluster, RenderSetup& s) {
   // (srgb, filmic; the EXR of such a render too, so that both formats hold one linear image);
   // --tonemap clamp keeps the course renderer's look: textures and output as stored.
   a.load.linearizeSrgbTextures = a.tonemap != io::ToneMap::Clamp;
+  // Only lightcuts' clear clusters query the occluder index (scene/occluders.h).
+  a.load.occluders = a.method == lightcuts::Method::Lightcuts && a.clearClusters;
   a.load.quiet = a.quiet;
   a.load.interruptible = true;
   try {

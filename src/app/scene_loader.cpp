@@ -40,6 +40,7 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
   bo.limits = o.limits;
   bo.threads = o.threads;
   bo.linearizeSrgbTextures = o.linearizeSrgbTextures;
+  bo.occluders = o.occluders;
   out.scene = scene::Scene::build(desc, bo);
   out.accelSeconds = since(t1);
 

@@ -44,6 +44,8 @@ struct LoadOptions {
   std::optional<float> causticSmoothing;
   // Linearise sRGB-marked (MTL) textures: scene::BuildOptions::linearizeSrgbTextures.
   bool linearizeSrgbTextures = false;
+  // scene::BuildOptions::occluders: for lightcuts with --clear-clusters on.
+  bool occluders = true;
   bool quiet = false;
   // SIGINT/SIGTERM stop the object lights and VPLs (app/interrupt.h): loadScene then throws
   // lc::Interrupted. Off, the signals keep their default effect.
@@ -59,7 +61,7 @@ struct LoadedScene {
   std::vector<std::string> warnings;
   std::string objDescription;  // the default camera/lights added for an OBJ file, in .ray syntax
   double loadSeconds = 0;      // parsing and textures
-  double accelSeconds = 0;     // Embree BVH
+  double accelSeconds = 0;     // Embree BVH (and the occluder index, when built)
   double lightSeconds = 0;     // object lights, environment lights and VPLs
 };
 

@@ -70,7 +70,7 @@ Color ShadowRays::trace(const Vec3& wi, float dist, int& blocker, float& tHit) {
 // box is in front of: no ray re-enters it.
 bool ShadowRays::boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) {
   const Vec3 c = (lo + hi) * 0.5f, h = (hi - lo) * 0.5f;
-  if (!(dot(ng_, c - p_) - dot(vabs(ng_), h) > 2 * eps_)) return false;
+  if (!scene_.occluders().built() || !(dot(ng_, c - p_) - dot(vabs(ng_), h) > 2 * eps_)) return false;
   const Vec3 off = ng_ * eps_;
   return scene_.occluders().clear(p_ + off, lo + off, hi + off, 0.1f * eps_, 2 * eps_, ownShape_, &hint);
 }

@@ -35,7 +35,7 @@ struct Hull {
   Vec3 apex, c, h;  // the box's centre and half extent
   Vec3 lo, hi;      // the bounding box of both hulls' intersection
   float margin, shortfall;
-  float dMin, dMax;  // distances from the apex to the box
+  float invDMin, invDMax;  // reciprocal distances from the apex to the box (0 when it is inside)
   // The cone from the apex that holds the box, set up when first needed (most pieces are
   // set apart by the bounding boxes alone): none when the apex is near or in the box.
   mutable int cone = -1;  // -1 not set up, 0 none, 1 set
@@ -45,28 +45,34 @@ struct Hull {
   Hull(const Vec3& a, const Vec3& blo, const Vec3& bhi, float m, float s)
       : apex(a), c((blo + bhi) * 0.5f), h((bhi - blo) * 0.5f), margin(m), shortfall(s) {
     Vec3 near = vmax(vmax(blo - a, a - bhi), Vec3(0.0f));
-    dMin = length(near);
-    dMax = length(vmax(vabs(blo - a), vabs(bhi - a)));
+    const float dMin = length(near);
+    invDMin = dMin > 0 ? 1 / dMin : 0;
+    invDMax = dMin > 0 ? 1 / length(vmax(vabs(blo - a), vabs(bhi - a))) : 0;
+    // The world axes: extent() with n a unit axis, written out.
     for (int k = 0; k < 3; ++k) {
-      Vec3 n(0.0f);
-      n[k] = 1;
-      float elo, ehi;
-      extent(n, elo, ehi);
-      lo[k] = elo;
-      hi[k] = ehi;
+      float blok = blo[k], bhik = bhi[k];
+      if (shortfall > 0 && invDMin > 0) {
+        float q0 = blok - a[k], q1 = bhik - a[k];
+        float wlo = std::max(-1.0f, q0 * (q0 < 0 ? invDMin : invDMax));
+        float whi = std::min(1.0f, q1 * (q1 < 0 ? invDMax : invDMin));
+        blok = std::max(blok, blo[k] - shortfall * whi);
+        bhik = std::min(bhik, bhi[k] - shortfall * wlo);
+      }
+      lo[k] = std::min(a[k], blok);
+      hi[k] = std::max(a[k], bhik);
     }
   }
   // The range of n . wi over the unit directions wi from the apex to the box.
   void directionRange(const Vec3& n, float& lo, float& hi) const {
-    if (!(dMin > 0)) {
+    if (!(invDMin > 0)) {
       lo = -1;
       hi = 1;
       return;
     }
     float qc = dot(n, c - apex), qh = dot(vabs(n), h);
     float q0 = qc - qh, q1 = qc + qh;
-    lo = std::max(-1.0f, q0 < 0 ? q0 / dMin : q0 / dMax);
-    hi = std::min(1.0f, q1 < 0 ? q1 / dMax : q1 / dMin);
+    lo = std::max(-1.0f, q0 * (q0 < 0 ? invDMin : invDMax));
+    hi = std::min(1.0f, q1 * (q1 < 0 ? invDMax : invDMin));
   }
   // The extent along unit axis n of the two hulls' intersection.
   void extent(const Vec3& n, float& elo, float& ehi) const {
@@ -111,6 +117,19 @@ struct Hull {
     float x2 = ax > 0 ? ax * ax : 0, y2 = ay > 0 ? ay * ay : 0;
     return mz < cosAngle * std::sqrt(x2 + y2 + mz * mz);
   }
+  // Whether a plane through the apex and an edge of triangle v separates it from the box:
+  // the hull meets that plane only at the apex, the triangle lies on its other side.
+  bool triangleApart(const Vec3* v) const {
+    const Vec3 e[3] = {v[0] - apex, v[1] - apex, v[2] - apex};
+    const Vec3 ca = c - apex;
+    for (int i = 0; i < 3; ++i) {
+      const Vec3 m = cross(e[i], e[(i + 1) % 3]);
+      const float s = dot(m, e[(i + 2) % 3]);
+      const float bc = dot(m, ca), bh = dot(vabs(m), h), tol = margin * length(m);
+      if ((s > 0 && bc + bh < -tol) || (s < 0 && bc - bh > tol)) return true;
+    }
+    return false;
+  }
   // Whether unit axis n separates the hulls from the extent [plo, phi] along n.
   bool axisApart(const Vec3& n, float plo, float phi) const {
     float elo, ehi;
@@ -126,40 +145,21 @@ using detail::kLeafPieces;
 using detail::pad;
 using detail::padded;
 
-OccluderIndex::OccluderIndex(const std::vector<Shape>& shapes, const std::vector<Mesh>& meshes) {
+OccluderIndex::OccluderIndex(const std::vector<Shape>& shapes, const std::vector<Mesh>& meshes)
+    : shapes_(&shapes), meshes_(&meshes), built_(true) {
+  quadrics_.resize(shapes.size());
   for (size_t si = 0; si < shapes.size(); ++si) {
     const Shape& s = shapes[si];
     if (s.kind == ShapeKind::Mesh) {
-      const Mesh& m = meshes[size_t(s.mesh)];
-      for (const auto& tri : m.triangles) {
-        const Vec3 &p0 = m.positions[size_t(tri[0])], &p1 = m.positions[size_t(tri[1])],
-                   &p2 = m.positions[size_t(tri[2])];
-        Piece p;
-        p.shape = int(si);
-        p.box = Bounds3(p0, p1);
-        p.box.extend(p2);
-        p.box = padded(p.box);
-        Vec3d e1 = Vec3d(p1) - Vec3d(p0), e2 = Vec3d(p2) - Vec3d(p0);
-        Vec3d n(e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x);
-        double len = std::sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
-        if (len > 0 && std::isfinite(len)) {
-          Vec3 nf = Vec3(float(n.x / len), float(n.y / len), float(n.z / len));
-          float d0 = dot(nf, p0), d1 = dot(nf, p1), d2 = dot(nf, p2);
-          p.axes = 1;
-          p.axis[0] = nf;
-          p.lo[0] = std::min({d0, d1, d2});
-          p.hi[0] = std::max({d0, d1, d2});
-          pad(p.lo[0], p.hi[0]);
-        }
-        pieces_.push_back(p);
-      }
+      const size_t n = meshes[size_t(s.mesh)].triangles.size();
+      for (size_t t = 0; t < n; ++t) pieces_.push_back({uint32_t(si), uint32_t(t)});
       continue;
     }
-    Piece p;
-    p.shape = int(si);
-    p.box = quadricBounds(s);
+    pieces_.push_back({uint32_t(si), 0});
     // The shape lies in its local bounds: along each local axis (a row of toLocal, the
     // normal of the local planes x, y or z = const), within the bounds' corners' extent.
+    QuadricAxes& q = quadrics_[si];
+    q.box = quadricBounds(s);
     Bounds3 local;
     switch (s.kind) {
       case ShapeKind::Sphere: local = Bounds3(Vec3(-1.0f), Vec3(1.0f)); break;
@@ -187,29 +187,50 @@ OccluderIndex::OccluderIndex(const std::vector<Shape>& shapes, const std::vector
         hi = std::max(hi, d);
       }
       pad(lo, hi);
-      p.axis[p.axes] = n;
-      p.lo[p.axes] = lo;
-      p.hi[p.axes] = hi;
-      ++p.axes;
+      q.axis[q.axes] = n;
+      q.lo[q.axes] = lo;
+      q.hi[q.axes] = hi;
+      ++q.axes;
     }
-    if (p.axes != 3) p.axes = 0;  // a degenerate frame: its bounding box alone
-    pieces_.push_back(p);
+    if (q.axes != 3) q.axes = 0;  // a degenerate frame: its bounding box alone
   }
   if (pieces_.empty()) return;
-  std::vector<Vec3> centres(pieces_.size());
-  for (size_t i = 0; i < pieces_.size(); ++i) centres[i] = pieces_[i].box.center();
-  nodes_.reserve(2 * pieces_.size() / kLeafPieces + 2);
+  // Built over an order of the pieces, their boxes and centres computed once (freed after).
+  const size_t n = pieces_.size();
+  std::vector<Bounds3> boxes(n);
+  std::vector<Vec3> centres(n);
+  for (size_t i = 0; i < n; ++i) {
+    boxes[i] = pieceBox(pieces_[i]);
+    centres[i] = boxes[i].center();
+  }
+  std::vector<uint32_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
+  nodes_.reserve(2 * n / kLeafPieces + 2);
   nodes_.emplace_back();
-  build(0, 0, uint32_t(pieces_.size()), centres);
+  build(0, 0, uint32_t(n), order, boxes, centres);
+  std::vector<Piece> sorted(n);
+  for (size_t i = 0; i < n; ++i) sorted[i] = pieces_[order[i]];
+  pieces_.swap(sorted);
 }
 
-// Fills node `self` for pieces [begin, end): a leaf, or a split at the median centre along
-// the centres' longest axis into two children stored side by side.
-void OccluderIndex::build(uint32_t self, uint32_t begin, uint32_t end, std::vector<Vec3>& centres) {
+Bounds3 OccluderIndex::pieceBox(const Piece& p) const {
+  const Shape& s = (*shapes_)[p.shape];
+  if (s.kind != ShapeKind::Mesh) return quadrics_[p.shape].box;
+  const Mesh& m = (*meshes_)[size_t(s.mesh)];
+  const auto& tri = m.triangles[p.prim];
+  Bounds3 b(m.positions[size_t(tri[0])], m.positions[size_t(tri[1])]);
+  b.extend(m.positions[size_t(tri[2])]);
+  return padded(b);
+}
+
+// Fills node `self` for the pieces order[begin, end): a leaf, or a split at the median
+// centre along the centres' longest axis into two children stored side by side.
+void OccluderIndex::build(uint32_t self, uint32_t begin, uint32_t end, std::vector<uint32_t>& order,
+                          const std::vector<Bounds3>& boxes, const std::vector<Vec3>& centres) {
   Bounds3 box, cbox;
   for (uint32_t i = begin; i < end; ++i) {
-    box.extend(pieces_[i].box);
-    cbox.extend(centres[i]);
+    box.extend(boxes[order[i]]);
+    cbox.extend(centres[order[i]]);
   }
   nodes_[self].box = box;
   if (end - begin <= kLeafPieces) {
@@ -220,44 +241,56 @@ void OccluderIndex::build(uint32_t self, uint32_t begin, uint32_t end, std::vect
   Vec3 e = cbox.extent();
   int axis = e.x >= e.y && e.x >= e.z ? 0 : e.y >= e.z ? 1 : 2;
   uint32_t mid = begin + (end - begin) / 2;
-  std::vector<uint32_t> order(end - begin);
-  for (uint32_t i = 0; i < order.size(); ++i) order[i] = begin + i;
-  std::nth_element(order.begin(), order.begin() + (mid - begin), order.end(), [&](uint32_t a, uint32_t b) {
+  std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end, [&](uint32_t a, uint32_t b) {
     float ca = centres[a][axis], cb = centres[b][axis];
     return ca < cb || (ca == cb && a < b);
   });
-  std::vector<Piece> ps(order.size());
-  std::vector<Vec3> cs(order.size());
-  for (size_t i = 0; i < order.size(); ++i) {
-    ps[i] = pieces_[order[i]];
-    cs[i] = centres[order[i]];
-  }
-  std::copy(ps.begin(), ps.end(), pieces_.begin() + begin);
-  std::copy(cs.begin(), cs.end(), centres.begin() + begin);
   const uint32_t first = uint32_t(nodes_.size());
   nodes_.emplace_back();
   nodes_.emplace_back();
   nodes_[self].first = first;
   nodes_[self].count = 0;
-  build(first, begin, mid, centres);
-  build(first + 1, mid, end, centres);
+  build(first, begin, mid, order, boxes, centres);
+  build(first + 1, mid, end, order, boxes, centres);
 }
 
-bool OccluderIndex::pieceApart(const Hull& hull, uint32_t i, int skip) const {
-  const Piece& p = pieces_[i];
-  if (p.shape == skip || hull.boxApart(p.box)) return true;
-  for (int k = 0; k < p.axes; ++k)
-    if (hull.axisApart(p.axis[k], p.lo[k], p.hi[k])) return true;
-  return false;
+bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const {
+  if (int(p.shape) == skip) return true;
+  const Shape& s = (*shapes_)[p.shape];
+  if (s.kind != ShapeKind::Mesh) {
+    const QuadricAxes& q = quadrics_[p.shape];
+    if (hull.boxApart(q.box)) return true;
+    for (int k = 0; k < q.axes; ++k)
+      if (hull.axisApart(q.axis[k], q.lo[k], q.hi[k])) return true;
+    return false;
+  }
+  const Mesh& m = (*meshes_)[size_t(s.mesh)];
+  const auto& tri = m.triangles[p.prim];
+  const Vec3 v[3] = {m.positions[size_t(tri[0])], m.positions[size_t(tri[1])], m.positions[size_t(tri[2])]};
+  Bounds3 b(v[0], v[1]);
+  b.extend(v[2]);
+  if (hull.boxApart(padded(b))) return true;
+  // Its plane: the triangle's extent along its normal (one value, padded for rounding).
+  Vec3 n = cross(v[1] - v[0], v[2] - v[0]);
+  const float len = length(n);
+  if (len > 0 && std::isfinite(len)) {
+    n = n / len;
+    float d0 = dot(n, v[0]), d1 = dot(n, v[1]), d2 = dot(n, v[2]);
+    float lo = std::min({d0, d1, d2}), hi = std::max({d0, d1, d2});
+    pad(lo, hi);
+    if (hull.axisApart(n, lo, hi)) return true;
+  }
+  return hull.triangleApart(v);
 }
 
 bool OccluderIndex::clear(const Vec3& apex, const Vec3& lo, const Vec3& hi, float margin, float shortfall,
                           int skip, uint32_t* hint) const {
+  if (!built_) return false;
   if (nodes_.empty()) return true;
   const Hull hull(apex, lo, hi, margin, shortfall);
   // The piece that stopped the last query is often in the way of this one too (a pillar
   // between the point and a group of clusters): tried first, a "no" costs one piece.
-  if (hint && *hint < pieces_.size() && !pieceApart(hull, *hint, skip)) return false;
+  if (hint && *hint < pieces_.size() && !pieceApart(hull, pieces_[*hint], skip)) return false;
   uint32_t stack[64];
   int top = 0, visits = 0;
   stack[top++] = 0;
@@ -272,7 +305,7 @@ bool OccluderIndex::clear(const Vec3& apex, const Vec3& lo, const Vec3& hi, floa
       continue;
     }
     for (uint32_t i = n.first; i < n.first + n.count; ++i) {
-      if (pieceApart(hull, i, skip)) continue;
+      if (pieceApart(hull, pieces_[i], skip)) continue;
       if (hint) *hint = i;
       return false;
     }

@@ -14,8 +14,9 @@
 // outside the cone is outside the hull).
 //
 // Embree's BVH is not open to custom queries (rtcPointQuery takes a sphere, rtcCollide
-// user geometry only), so the hierarchy is our own: a median split, built once with the
-// scene, a few dozen bytes per piece.
+// user geometry only), so the hierarchy is our own: a median split over the pieces, which
+// refer to the scene's shapes and triangles (8 bytes each, 24 with the nodes). Built on
+// request (scene::BuildOptions::occluders), where lightcuts will ask.
 #pragma once
 
 #include <cstdint>
@@ -36,8 +37,10 @@ class OccluderIndex {
   // cost in scenes of many triangles near the hull, where the answer is rarely yes.
   static constexpr int kMaxVisits = 48;
 
+  // Not built: every query answers "not clear".
   OccluderIndex() = default;
-  // Every surface of the scene, shapes in world space (meshes by their triangles).
+  // Every surface of the scene: its shapes in world space, meshes by their triangles. The
+  // vectors must outlive the index (the scene's own); about 24 bytes per triangle.
   OccluderIndex(const std::vector<Shape>& shapes, const std::vector<Mesh>& meshes);
 
   // Whether no piece can meet a segment from `apex` toward a point of the box [lo, hi] that
@@ -50,25 +53,35 @@ class OccluderIndex {
   bool clear(const Vec3& apex, const Vec3& lo, const Vec3& hi, float margin, float shortfall = 0,
              int skip = -1, uint32_t* hint = nullptr) const;
 
+  bool built() const { return built_; }
   size_t pieceCount() const { return pieces_.size(); }
 
  private:
   struct Piece {
+    uint32_t shape, prim;  // prim: the triangle of a mesh
+  };
+  // A quadric's world bounds and three local axes with its extent along each.
+  struct QuadricAxes {
     Bounds3 box;
-    int shape = 0;
-    int axes = 0;  // 0, 1 (a triangle's normal) or 3 (a quadric's local axes)
+    int axes = 0;  // 3, or 0 for a degenerate frame
     Vec3 axis[3];
-    float lo[3], hi[3];  // the piece's extent along each axis
+    float lo[3], hi[3];
   };
   struct Node {
     Bounds3 box;
     // Inner: children at `first` and first + 1 (in nodes_); leaf: pieces [first, first + count).
     uint32_t first = 0, count = 0;
   };
-  bool pieceApart(const detail::Hull& hull, uint32_t i, int skip) const;
-  void build(uint32_t self, uint32_t begin, uint32_t end, std::vector<Vec3>& centres);
+  Bounds3 pieceBox(const Piece& p) const;
+  bool pieceApart(const detail::Hull& hull, const Piece& p, int skip) const;
+  void build(uint32_t self, uint32_t begin, uint32_t end, std::vector<uint32_t>& order,
+             const std::vector<Bounds3>& boxes, const std::vector<Vec3>& centres);
 
+  const std::vector<Shape>* shapes_ = nullptr;
+  const std::vector<Mesh>* meshes_ = nullptr;
+  bool built_ = false;
   std::vector<Piece> pieces_;
+  std::vector<QuadricAxes> quadrics_;  // per shape (meshes' entries unused)
   std::vector<Node> nodes_;
 };
 

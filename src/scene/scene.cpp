@@ -331,7 +331,7 @@ void Scene::buildGeometry(const BuildOptions& options) {
   rtcCommitScene(rtc_);
   RTCError err = rtcGetDeviceError(device_);
   if (err != RTC_ERROR_NONE) throw Error(fmt::format("Embree failed to build the scene (error {})", int(err)));
-  occluders_ = OccluderIndex(shapes_, meshes_);
+  if (options.occluders) occluders_ = OccluderIndex(shapes_, meshes_);
 }
 
 size_t Scene::triangleCount() const {

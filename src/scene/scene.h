@@ -46,6 +46,10 @@ struct BuildOptions {
   // 8-bit texture reads as value/255, as the course renderer did; the CLI turns it on with
   // --tonemap srgb, whose output encoding undoes the linearisation.
   bool linearizeSrgbTextures = false;
+  // Build the occluder index (occluders.h) that lightcuts' clear clusters query; without
+  // it no cluster is known clear. About 24 bytes per triangle; the CLI leaves it out
+  // where nothing will query it (brute force, --clear-clusters off).
+  bool occluders = true;
 };
 
 class Scene {
