@@ -4,14 +4,14 @@
 // convex hull of the point and the box. When every piece is provably apart from the hull,
 // every segment from the point to a point of the box is clear, so a light cluster inside
 // the box is unoccluded as a whole: lightcuts then needs no shadow ray for any of its
-// lights (evaluator.cpp, --unoccluded-clusters). A "no" proves nothing; it only means the
-// test could not separate some piece (or gave up after kMaxVisits steps).
+// lights (evaluator.cpp, --clear-clusters). A "no" proves nothing; it only means the test
+// could not separate some piece (or gave up after kMaxVisits steps).
 //
-// A piece is apart from the hull when some axis separates them (the separating axis
+// A piece is apart from the hull when some plane separates them (the separating axis
 // theorem, on a few of its axes): the world axes (bounding boxes), the piece's own axes (a
 // triangle's normal; a quadric's three local axes, with the extent of its local bounds),
-// and the cone from the point that holds the box (a piece all of whose bounding box is
-// outside the cone is outside the hull).
+// a triangle's planes through the point and its edges, and the cone from the point that
+// holds the box (a piece all of whose bounding box is outside the cone is outside the hull).
 //
 // Embree's BVH is not open to custom queries (rtcPointQuery takes a sphere, rtcCollide
 // user geometry only), so the hierarchy is our own: a median split over the pieces, which
