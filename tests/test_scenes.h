@@ -21,4 +21,16 @@ scale(20, box {{ material = {{ diffuse = ({}, {}, {}); }}; }})
   return scene::Scene::build(io::parseRayString(text, "box.ray", ""));
 }
 
+// One primitive of `kind` under object-to-world m, with the given cylinder/cone shape.
+inline io::ObjectDesc primitive(io::ShapeKind kind, const Mat4& m, float height = 1.5f, float bottomRadius = 1,
+                                float topRadius = 0.5f) {
+  io::ObjectDesc o;
+  o.kind = kind;
+  o.transform = m;
+  o.height = height;
+  o.bottomRadius = bottomRadius;
+  o.topRadius = topRadius;
+  return o;
+}
+
 }  // namespace lc::testing

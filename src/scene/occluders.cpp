@@ -160,19 +160,7 @@ OccluderIndex::OccluderIndex(const std::vector<Shape>& shapes, const std::vector
     // normal of the local planes x, y or z = const), within the bounds' corners' extent.
     QuadricAxes& q = quadrics_[si];
     q.box = quadricBounds(s);
-    Bounds3 local;
-    switch (s.kind) {
-      case ShapeKind::Sphere: local = Bounds3(Vec3(-1.0f), Vec3(1.0f)); break;
-      case ShapeKind::Box: local = Bounds3(Vec3(-0.5f), Vec3(0.5f)); break;
-      case ShapeKind::Square: local = Bounds3(Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, 0.5f, 0)); break;
-      case ShapeKind::Cylinder: local = Bounds3(Vec3(-1, -1, 0), Vec3(1, 1, 1)); break;
-      case ShapeKind::Cone: {
-        float r = std::max(std::fabs(s.bottomRadius), std::fabs(s.topRadius));
-        local = Bounds3(Vec3(-r, -r, 0), Vec3(r, r, s.height));
-        break;
-      }
-      case ShapeKind::Mesh: break;
-    }
+    const Bounds3 local = quadricLocalBounds(s);
     for (int k = 0; k < 3; ++k) {
       const auto& row = s.toLocal.m[size_t(k)];
       double len = std::sqrt(row[0] * row[0] + row[1] * row[1] + row[2] * row[2]);

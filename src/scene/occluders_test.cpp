@@ -6,21 +6,14 @@
 
 #include "core/rng.h"
 #include "scene/scene.h"
+#include "test_scenes.h"
 
 namespace lc::scene {
 namespace {
 
 using io::ShapeKind;
 
-io::ObjectDesc object(ShapeKind kind, const Mat4& m) {
-  io::ObjectDesc o;
-  o.kind = kind;
-  o.transform = m;
-  o.height = 1.5f;
-  o.bottomRadius = 0.8f;
-  o.topRadius = 0.3f;
-  return o;
-}
+io::ObjectDesc object(ShapeKind kind, const Mat4& m) { return testing::primitive(kind, m, 1.5f, 0.8f, 0.3f); }
 
 Vec3 uniformIn(Rng& rng, const Vec3& lo, const Vec3& hi) {
   return lo + (hi - lo) * Vec3(rng.uniform(), rng.uniform(), rng.uniform());

@@ -8,6 +8,7 @@
 
 #include "core/rng.h"
 #include "scene/scene.h"
+#include "test_scenes.h"
 
 namespace lc::scene {
 namespace {
@@ -29,15 +30,7 @@ struct Builder {
     o.transform = m;
     d.objects.push_back(o);
   }
-  void shape(ShapeKind kind, const Mat4& m) {
-    io::ObjectDesc o;
-    o.kind = kind;
-    o.transform = m;
-    o.height = 1.5f;
-    o.bottomRadius = 1;
-    o.topRadius = 0.5f;
-    d.objects.push_back(o);
-  }
+  void shape(ShapeKind kind, const Mat4& m) { d.objects.push_back(testing::primitive(kind, m)); }
   // A grid of n x n quads over [-h,h]^2 in the plane z = z0, each split along a diagonal
   // (alternating direction when `alternate`).
   void wall(int n, float h, float z0, bool alternate) {

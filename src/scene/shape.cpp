@@ -222,20 +222,24 @@ Vec2 quadricUv(const Shape& s, const Vec3& p, int part) {
   return Vec2(0, 0);
 }
 
-Bounds3 quadricBounds(const Shape& s) {
-  Bounds3 local;
+Bounds3 quadricLocalBounds(const Shape& s) {
   switch (s.kind) {
-    case ShapeKind::Sphere: local = Bounds3(Vec3(-1, -1, -1), Vec3(1, 1, 1)); break;
-    case ShapeKind::Box: local = Bounds3(Vec3(-0.5f), Vec3(0.5f)); break;
-    case ShapeKind::Square: local = Bounds3(Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, 0.5f, 0)); break;
-    case ShapeKind::Cylinder: local = Bounds3(Vec3(-1, -1, 0), Vec3(1, 1, 1)); break;
+    case ShapeKind::Sphere: return Bounds3(Vec3(-1, -1, -1), Vec3(1, 1, 1));
+    case ShapeKind::Box: return Bounds3(Vec3(-0.5f), Vec3(0.5f));
+    case ShapeKind::Square: return Bounds3(Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, 0.5f, 0));
+    case ShapeKind::Cylinder: return Bounds3(Vec3(-1, -1, 0), Vec3(1, 1, 1));
     case ShapeKind::Cone: {
       float r = std::max(std::fabs(s.bottomRadius), std::fabs(s.topRadius));
-      local = Bounds3(Vec3(-r, -r, 0), Vec3(r, r, s.height));
-      break;
+      return Bounds3(Vec3(-r, -r, 0), Vec3(r, r, s.height));
     }
-    case ShapeKind::Mesh: return {};
+    case ShapeKind::Mesh: break;
   }
+  return {};
+}
+
+Bounds3 quadricBounds(const Shape& s) {
+  if (s.kind == ShapeKind::Mesh) return {};
+  const Bounds3 local = quadricLocalBounds(s);
   Bounds3 world;
   for (int i = 0; i < 8; ++i) {
     Vec3 c((i & 1) ? local.hi.x : local.lo.x, (i & 2) ? local.hi.y : local.lo.y,

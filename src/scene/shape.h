@@ -53,6 +53,8 @@ bool intersectQuadric(const Shape& s, const Vec3& o, const Vec3& d, float tmin, 
 // Local-space normal (not normalised) and uv of a local point on a quadric's `part`.
 Vec3 quadricLocalNormal(const Shape& s, const Vec3& p, int part);
 Vec2 quadricUv(const Shape& s, const Vec3& p, int part);
+// A quadric's bounds in its canonical frame (empty for meshes).
+Bounds3 quadricLocalBounds(const Shape& s);
 // World bounds of a quadric (its local bounding box, transformed).
 Bounds3 quadricBounds(const Shape& s);
 

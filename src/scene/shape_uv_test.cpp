@@ -8,6 +8,7 @@
 #include "io/image.h"
 #include "scene/scene.h"
 #include "scene/shape.h"
+#include "test_scenes.h"
 #include "test_util.h"
 
 namespace lc::scene {
@@ -126,13 +127,7 @@ std::unique_ptr<Scene> oneShape(ShapeKind kind, const Mat4& m, float height = 1,
                                 float r1 = 0) {
   io::SceneDesc d;
   d.materials.emplace_back();
-  io::ObjectDesc o;
-  o.kind = kind;
-  o.transform = m;
-  o.height = height;
-  o.bottomRadius = r0;
-  o.topRadius = r1;
-  d.objects.push_back(o);
+  d.objects.push_back(testing::primitive(kind, m, height, r0, r1));
   return Scene::build(d);
 }
 
