@@ -1,5 +1,6 @@
 // Ray throughput of the Embree scene: closest-hit camera rays and incoherent occlusion
-// (shadow) rays, single-threaded, on the Cornell box and on a generated ~1M-triangle mesh.
+// (shadow) rays, single-threaded, on the Cornell box and on a generated ~1M-triangle mesh;
+// and the occluder index's clear tests on the same scenes.
 // Run: build/bench/rays_bench
 #include <benchmark/benchmark.h>
 
@@ -97,8 +98,40 @@ void ShadowRays(benchmark::State& state) {
   state.SetLabel(state.range(0) == 0 ? "cornell box" : "1M-triangle mesh");
 }
 
+// The occluder index's clear test (scene/occluders.h, lightcuts' clear clusters) between
+// the same random points and random boxes around the second one (up to a tenth of the
+// scene's size): what a test costs beside a shadow ray, and how often it passes.
+void ClearTests(benchmark::State& state) {
+  const scene::Scene& s = sceneFor(int(state.range(0)));
+  Bounds3 b = s.bounds();
+  Rng rng(1, 2);
+  const int N = 65536;
+  struct Query {
+    Vec3 apex, lo, hi;
+  };
+  std::vector<Query> qs(N);
+  for (auto& q : qs) {
+    q.apex = b.lo + b.extent() * Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+    Vec3 c = b.lo + b.extent() * Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+    Vec3 h = b.extent() * 0.05f * Vec3(rng.uniform(), rng.uniform(), rng.uniform());
+    q.lo = c - h;
+    q.hi = c + h;
+  }
+  const float margin = 0.1f * s.epsilon();
+  int64_t tests = 0, passed = 0;
+  for (auto _ : state) {
+    uint32_t hint = ~0u;
+    for (const Query& q : qs) passed += s.occluders().clear(q.apex, q.lo, q.hi, margin, 0, -1, &hint);
+    tests += N;
+  }
+  state.counters["tests/s"] = benchmark::Counter(double(tests), benchmark::Counter::kIsRate);
+  state.counters["clear fraction"] = double(passed) / double(std::max<int64_t>(tests, 1));
+  state.SetLabel(state.range(0) == 0 ? "cornell box" : "1M-triangle mesh");
+}
+
 BENCHMARK(PrimaryRays)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(ShadowRays)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(ClearTests)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

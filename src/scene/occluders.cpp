@@ -13,17 +13,10 @@ namespace detail {
 constexpr uint32_t kLeafPieces = 4;
 
 // Pads an extent for the rounding of the float values it was computed from.
-void pad(float& lo, float& hi) {
+inline void pad(float& lo, float& hi) {
   float p = (std::fabs(lo) + std::fabs(hi) + (hi - lo)) * 1e-6f;
   lo -= p;
   hi += p;
-}
-
-Bounds3 padded(Bounds3 b) {
-  Vec3 p = (vabs(b.lo) + vabs(b.hi) + b.extent()) * 1e-6f;
-  b.lo -= p;
-  b.hi += p;
-  return b;
 }
 
 // The segments from an apex toward the points of a box, each ending `shortfall` before
@@ -40,7 +33,7 @@ struct Hull {
   // set apart by the bounding boxes alone): none when the apex is near or in the box.
   mutable int cone = -1;  // -1 not set up, 0 none, 1 set
   mutable Vec3 u, v, w, au, av, aw;
-  mutable float cosAngle = 1;
+  mutable float cos2Angle = 1;  // the cone's half-angle's cosine, squared
 
   Hull(const Vec3& a, const Vec3& blo, const Vec3& bhi, float m, float s)
       : apex(a), c((blo + bhi) * 0.5f), h((bhi - blo) * 0.5f), margin(m), shortfall(s) {
@@ -99,14 +92,17 @@ struct Hull {
     av = vabs(v);
     aw = vabs(w);
     float s = r / dist;
-    cosAngle = std::sqrt(1 - s * s);
+    cos2Angle = 1 - s * s;
     cone = 1;
     return true;
   }
-  bool boxApart(const Bounds3& b) const {
-    if (b.hi.x < lo.x - margin || b.lo.x > hi.x + margin || b.hi.y < lo.y - margin || b.lo.y > hi.y + margin ||
-        b.hi.z < lo.z - margin || b.lo.z > hi.z + margin)
-      return true;
+  // Whether box b is apart from the hulls: outside their bounding box or outside the cone.
+  bool boxApart(const Bounds3& b) const { return aabbApart(b) || coneApart(b); }
+  bool aabbApart(const Bounds3& b) const {
+    return b.hi.x < lo.x - margin || b.lo.x > hi.x + margin || b.hi.y < lo.y - margin || b.lo.y > hi.y + margin ||
+           b.hi.z < lo.z - margin || b.lo.z > hi.z + margin;
+  }
+  bool coneApart(const Bounds3& b) const {
     if (cone == 0 || (cone < 0 && !setUpCone())) return false;
     // The largest cosine between w and a vector from the apex into b (bounds.h's
     // cosBoundBox): below the cone's, b lies outside the cone and so outside the hull.
@@ -115,7 +111,7 @@ struct Hull {
     if (mz < 0) return true;
     float ax = std::fabs(dot(qc, u)) - dot(au, qh), ay = std::fabs(dot(qc, v)) - dot(av, qh);
     float x2 = ax > 0 ? ax * ax : 0, y2 = ay > 0 ? ay * ay : 0;
-    return mz < cosAngle * std::sqrt(x2 + y2 + mz * mz);
+    return mz * mz < cos2Angle * (x2 + y2 + mz * mz);  // mz < cos * length, both sides >= 0
   }
   // Whether a plane through the apex and an edge of triangle v separates it from the box:
   // the hull meets that plane only at the apex, the triangle lies on its other side.
@@ -143,7 +139,6 @@ struct Hull {
 using detail::Hull;
 using detail::kLeafPieces;
 using detail::pad;
-using detail::padded;
 
 OccluderIndex::OccluderIndex(const std::vector<Shape>& shapes, const std::vector<Mesh>& meshes)
     : shapes_(&shapes), meshes_(&meshes), built_(true) {
@@ -208,7 +203,7 @@ Bounds3 OccluderIndex::pieceBox(const Piece& p) const {
   const auto& tri = m.triangles[p.prim];
   Bounds3 b(m.positions[size_t(tri[0])], m.positions[size_t(tri[1])]);
   b.extend(m.positions[size_t(tri[2])]);
-  return padded(b);
+  return b;
 }
 
 // Fills node `self` for the pieces order[begin, end): a leaf, or a split at the median
@@ -255,9 +250,11 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
   const Mesh& m = (*meshes_)[size_t(s.mesh)];
   const auto& tri = m.triangles[p.prim];
   const Vec3 v[3] = {m.positions[size_t(tri[0])], m.positions[size_t(tri[1])], m.positions[size_t(tri[2])]};
+  // The triangle is within its vertices' box exactly (the margin covers the hit test's
+  // rounding), so the box needs no padding. The cheap tests first: the box, the plane.
   Bounds3 b(v[0], v[1]);
   b.extend(v[2]);
-  if (hull.boxApart(padded(b))) return true;
+  if (hull.aabbApart(b)) return true;
   // Its plane: the triangle's extent along its normal (one value, padded for rounding).
   Vec3 n = cross(v[1] - v[0], v[2] - v[0]);
   const float len = length(n);
@@ -268,7 +265,7 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
     pad(lo, hi);
     if (hull.axisApart(n, lo, hi)) return true;
   }
-  return hull.triangleApart(v);
+  return hull.coneApart(b) || hull.triangleApart(v);
 }
 
 bool OccluderIndex::clear(const Vec3& apex, const Vec3& lo, const Vec3& hi, float margin, float shortfall,
