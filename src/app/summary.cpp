@@ -53,7 +53,7 @@ void forEachEvalCounter(S& s, F&& f) {
   f("occluded_rays", s.occludedRays);
   f("hidden_clusters", s.hiddenClusters);
   f("clear_tests", s.clearTests);
-  f("cleared_clusters", s.clearClusters);
+  f("cleared_clusters", s.clearedClusters);
   f("group_probes", s.groupProbes);
   f("failed_group_probes", s.failedGroupProbes);
   f("traced_rays", s.tracedRays);
@@ -174,7 +174,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["hidden_clusters"] = es.hiddenClusters;
   j["clear_clusters"] = switchName(a.clearClusters);
   j["clear_tests"] = es.clearTests;
-  j["cleared_clusters"] = es.clearClusters;
+  j["cleared_clusters"] = es.clearedClusters;
   j["group_probes"] = es.groupProbes;
   j["failed_group_probes"] = es.failedGroupProbes;
   j["reconstruct_spacing"] = ro.reconstructSpacing;

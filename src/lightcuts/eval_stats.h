@@ -23,7 +23,7 @@ struct EvalStats {
   uint64_t occludedRays = 0;         // shadow rays that found their light hidden
   uint64_t hiddenClusters = 0;       // clusters kept in a cut as hidden by their probes
   uint64_t clearTests = 0;           // clusters tested for being visible as a whole (boxClear)
-  uint64_t clearClusters = 0;        // those found so
+  uint64_t clearedClusters = 0;      // those found so
   uint64_t groupProbes = 0;          // rays testing groups of borrowed-visible nodes (reconstruction.h)
   uint64_t failedGroupProbes = 0;    // those groups found hidden where every sample saw them
   // Time, filled by the caller's Visibility and shading loop where they measure it:
@@ -61,7 +61,7 @@ struct EvalStats {
     occludedRays += o.occludedRays;
     hiddenClusters += o.hiddenClusters;
     clearTests += o.clearTests;
-    clearClusters += o.clearClusters;
+    clearedClusters += o.clearedClusters;
     groupProbes += o.groupProbes;
     failedGroupProbes += o.failedGroupProbes;
     tracedRays += o.tracedRays;

@@ -91,8 +91,8 @@ constexpr uint32_t kClearMinLights = 16;
 // kClearFailuresPerSuccess per success: where surfaces stand near most clusters (a church's
 // columns and vaults) tests rarely succeed, and each costs about what a ray does; where
 // they succeed, it is mostly on the small clusters tested after the large ones failed.
-// Measured (issue 21, --stats clear_tests): the Cornell box passes 13% of its tests, the
-// 100k-light room 16%, the church 1.3%.
+// Measured (issue 21, --stats clear_tests): the Cornell box and the 100k-light room pass 17%
+// of their tests, the church 0.15%.
 constexpr uint32_t kClearGraceFailures = 48;
 constexpr uint32_t kClearFailuresPerSuccess = 8;
 
@@ -112,13 +112,19 @@ struct ShadowResult {
 };
 
 // M * G * V of one light per unit intensity (one shadow ray when the rest is non-zero).
+// clear: its visibility is known to be 1 (a clear cluster's light, Visibility::boxClear):
+// no ray, and recorded as visible.
 inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoint& sp, Visibility& vis,
-                          EvalStats& stats, ShadowResult& res, bool wantBlocker = false) {
+                          EvalStats& stats, ShadowResult& res, bool wantBlocker = false, bool clear = false) {
   Color mg;
   Vec3 wi;
   float dist;
   res = ShadowResult{};
   if (!lightContribution(l, g, sp, mg, wi, dist)) return Color(0);
+  if (clear) {
+    res.found = CutVisibility::Visible;
+    return mg;
+  }
   ++stats.shadowRays;
   Color v = wantBlocker ? vis.trace(wi, dist, res.blocker, res.tHit) : vis(wi, dist);
   res.found = isBlack(v) ? CutVisibility::Occluded
@@ -126,18 +132,6 @@ inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoin
                                                     : CutVisibility::Partial;
   stats.occludedRays += res.found == CutVisibility::Occluded;
   return mg * v;
-}
-
-// M * G of one light per unit intensity where its visibility is known to be 1 (a clear
-// cluster's light): no shadow ray; recorded as visible when it gives anything.
-inline Color clearUnit(const Light& l, const LightGroup& g, const ShadingPoint& sp, ShadowResult& res) {
-  Color mg;
-  Vec3 wi;
-  float dist;
-  res = ShadowResult{};
-  if (!lightContribution(l, g, sp, mg, wi, dist)) return Color(0);
-  res.found = CutVisibility::Visible;
-  return mg;
 }
 
 class BruteForce final : public LightEvaluator {
@@ -359,21 +353,6 @@ class Lightcuts final : public LightEvaluator {
       }
     };
 
-    // A second stage of prefetching, after each refinement: the children of the nodes pushed
-    // one refinement ago have arrived (addNode fetched them); fetch their representatives'
-    // lights, which the next refinement's shadow ray reads (a miss on the light was half of
-    // lightContribution's time, perf on 100k point lights).
-    auto prefetchPending = [&] {
-      for (uint32_t k = 0; k < pendingCount; ++k) {
-        const LightTree& ptree = forest_.trees[pending[k].tree];
-        for (NodeRef c : {pending[k].left, pending[k].right})
-          if (!isLeafRef(c)) __builtin_prefetch(&lights_.lights[ptree.nodes[c].rep]);
-      }
-      pendingCount = freshCount;
-      for (uint32_t k = 0; k < freshCount; ++k) pending[k] = fresh[k];
-      freshCount = 0;
-    };
-
     uint32_t cutRoots = 0;
     for (uint32_t t = 0; t < forest_.trees.size(); ++t) {
       const LightTree& tree = forest_.trees[t];
@@ -431,7 +410,7 @@ class Lightcuts final : public LightEvaluator {
         ++stats.clearTests;
         const LightNode& pn = tree.nodes[cn.node];
         cnClear = vis.boxClear(pn.lo, pn.hi, blocker);
-        stats.clearClusters += cnClear;
+        stats.clearedClusters += cnClear;
         (cnClear ? clearSuccesses : clearFailures) += 1;
       }
       ShadowResult shadows[2];
@@ -440,18 +419,14 @@ class Lightcuts final : public LightEvaluator {
       for (uint32_t k = 0; k < 2; ++k) {
         const NodeRef c = k ? cn.right : cn.left;
         const uint32_t rep = tree.repOf(c);
-        const Light& l = lights_.lights[rep];
         // The child that shares the parent's representative reuses its shadow ray; in a
         // clear cluster no child needs one. Only clusters that may be probed need to know
         // what hid their representative.
         shadows[k] = cn.shadow;
-        if (rep == cn.rep)
-          units[k] = cn.unit;
-        else if (cnClear)
-          units[k] = clearUnit(l, lights_.groups[l.group], sp, shadows[k]);
-        else
-          units[k] = shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, shadows[k],
-                                  probes && tree.lightCount(c) >= kProbeMinLights);
+        units[k] = rep == cn.rep ? cn.unit
+                                 : shadowedUnit(lights_.lights[rep], lights_.groups[lights_.lights[rep].group], sp,
+                                                vis, stats, shadows[k],
+                                                probes && tree.lightCount(c) >= kProbeMinLights, cnClear);
       }
       // A shadow boundary: one child's representative is hidden, the other's not (never in
       // a clear cluster, whose refinements count in the boundary rate as their rays would
@@ -464,7 +439,18 @@ class Lightcuts final : public LightEvaluator {
       }
       addNode(cn.tree, cn.left, LightNode::leftPre(cn.pre), units[0], shadows[0], boundary, cnClear, blocker);
       addNode(cn.tree, cn.right, cn.rightPre, units[1], shadows[1], boundary, cnClear, blocker);
-      prefetchPending();
+      // A second stage of prefetching: the children of the nodes pushed one refinement ago
+      // have arrived (addNode fetched them); fetch their representatives' lights, which the
+      // next refinement's shadow ray reads (a miss on the light was half of
+      // lightContribution's time, perf on 100k point lights).
+      for (uint32_t k = 0; k < pendingCount; ++k) {
+        const LightTree& ptree = forest_.trees[pending[k].tree];
+        for (NodeRef c : {pending[k].left, pending[k].right})
+          if (!isLeafRef(c)) __builtin_prefetch(&lights_.lights[ptree.nodes[c].rep]);
+      }
+      pendingCount = freshCount;
+      for (uint32_t k = 0; k < freshCount; ++k) pending[k] = fresh[k];
+      freshCount = 0;
     }
     // The first-order estimates of the clusters left in the cut, kept within their bounds;
     // their ratio to the representative's is what a reconstruction borrows. Their nodes,

@@ -122,7 +122,7 @@ TEST(Accuracy, ClearClustersAreExactAndSaveShadowRays) {
   auto lcExact = lightcuts::makeLightcuts(s->lights(), forest, exact);
   RenderResult ref = renderWith(*s, *brute, 24);
   RenderResult test = renderWith(*s, *lcExact, 24);
-  EXPECT_GT(test.stats.eval.clearClusters, 100u);
+  EXPECT_GT(test.stats.eval.clearedClusters, 100u);
   for (size_t i = 0; i < ref.image.pixels.size(); ++i)
     for (int c = 0; c < 3; ++c)
       ASSERT_NEAR(test.image.pixels[i][c], ref.image.pixels[i][c], 1e-4f * (ref.image.pixels[i][c] + 1e-3f)) << i;

@@ -1,7 +1,6 @@
 #include "scene/occluders.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 
 namespace lc::scene {
@@ -41,18 +40,10 @@ struct Hull {
     const float dMin = length(near);
     invDMin = dMin > 0 ? 1 / dMin : 0;
     invDMax = dMin > 0 ? 1 / length(vmax(vabs(blo - a), vabs(bhi - a))) : 0;
-    // The world axes: extent() with n a unit axis, written out.
     for (int k = 0; k < 3; ++k) {
-      float blok = blo[k], bhik = bhi[k];
-      if (shortfall > 0 && invDMin > 0) {
-        float q0 = blok - a[k], q1 = bhik - a[k];
-        float wlo = std::max(-1.0f, q0 * (q0 < 0 ? invDMin : invDMax));
-        float whi = std::min(1.0f, q1 * (q1 < 0 ? invDMax : invDMin));
-        blok = std::max(blok, blo[k] - shortfall * whi);
-        bhik = std::min(bhik, bhi[k] - shortfall * wlo);
-      }
-      lo[k] = std::min(a[k], blok);
-      hi[k] = std::max(a[k], bhik);
+      Vec3 n(0.0f);
+      n[k] = 1;
+      extent(n, lo[k], hi[k]);
     }
   }
   // The range of n . wi over the unit directions wi from the apex to the box.
