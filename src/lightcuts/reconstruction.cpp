@@ -10,10 +10,6 @@ namespace {
 constexpr int kMaxSamples = 4;
 constexpr uint8_t kAbove = 0xff;  // the sample refined this node: its cut lies below
 
-// A group of borrowed-visible nodes is checked with a probe ray when it holds more than
-// this share of the point's light.
-constexpr float kGroupShare = 0.04f;
-
 // A coarser cut is borrowed only from samples this many times closer to each other than
 // to the cluster (squared).
 constexpr float kCoarsenRatio2 = 8.0f * 8.0f;
@@ -244,7 +240,7 @@ Color withRay(const LightSet& lights, const MergedCut::Node& node, const Shading
 }  // namespace
 
 ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& cut, const ShadingPoint& sp,
-                                       Visibility& vis, EvalStats& stats) {
+                                       Visibility& vis, EvalStats& stats, float probeShare) {
   // The nodes that need a ray, one by one; then the batched nodes four at a time, group
   // by group.
   Color total(0);
@@ -260,7 +256,7 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
   }
   // A group that holds a share of the light worth checking gets its probe's ray; hidden,
   // the group's nodes get one each.
-  const float worth = kGroupShare * luminance(total);
+  const float worth = probeShare * luminance(total);
   for (size_t g = 0; g < groups; ++g) {
     if (!(luminance(groupSum[g]) > worth)) continue;
     const MergedCut::Node& probe = cut.nodes[cut.groupProbe[g]];

@@ -91,9 +91,9 @@ struct MergedCut {
   MergedBatch batch;        // the batched nodes again, four lanes at a time
   // The batched nodes in groups of kGroupSize, in batch order (neighbours in the tree:
   // lights near each other). Each group has a probe, its brightest node: a point sends it
-  // a shadow ray when the group holds over 4% of its light, and if it is hidden there,
-  // where every sample saw it, the point tests each node of the group (a shadow thinner
-  // than the sample spacing: the blind spot of borrowed visibility).
+  // a shadow ray when the group holds over a share of its light (groupProbeShare), and if
+  // it is hidden there, where every sample saw it, the point tests each node of the group
+  // (a shadow thinner than the sample spacing: the blind spot of borrowed visibility).
   static constexpr uint32_t kGroupSize = 32;  // eight blocks
   std::vector<uint32_t> batchNodes;  // per batched node: its index in `nodes`
   std::vector<uint32_t> groupProbe;  // per group: the index in `nodes` of its probe
@@ -120,9 +120,17 @@ struct ReconstructionResult {
   uint32_t cutSize = 0;  // nodes in the reconstructed cut
 };
 
+// The share of a point's light above which a group of borrowed-visible nodes gets its
+// probe ray: half the cut's error ratio. A group that every sample saw and the point does
+// not is off by all of its light, so a group left unprobed can cost at most half the error
+// the cut is allowed. (A fixed 4% let single groups put the church's and the Roman hall's
+// edge pixels 10-20% over at 512x512; docs/LIGHTCUTS.md, "Group probes".)
+inline float groupProbeShare(float errorRatio) { return 0.5f * errorRatio; }
+
 // Direct light at `sp` over a merged cut. Shadow rays go through `vis`; shadow rays and
-// the cut are counted in `stats`.
+// the cut are counted in `stats`. A group of borrowed-visible nodes that holds more than
+// `probeShare` of the point's light gets a probe ray (groupProbeShare).
 ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& cut, const ShadingPoint& sp,
-                                       Visibility& vis, EvalStats& stats);
+                                       Visibility& vis, EvalStats& stats, float probeShare);
 
 }  // namespace lc::lightcuts

@@ -8,6 +8,7 @@
 #include <functional>
 
 #include "lightcuts/evaluator.h"
+#include "lightcuts/merged_batch.h"
 #include "test_lights.h"
 
 namespace lc::lightcuts {
@@ -169,6 +170,60 @@ TEST(Reconstruction, ASampleRebuildsItsOwnLightcutWithoutShadowRays) {
   EXPECT_EQ(e.cutSize, full.cutSize);
   EXPECT_NEAR(luminance(e.radiance), luminance(full.radiance), 1e-4f * luminance(full.radiance));
   EXPECT_EQ(st.reconstructedPoints, 1u);
+}
+
+// A group of borrowed-visible nodes that the point does not see though every sample did (a
+// shadow thinner than the sample spacing) is caught by its probe when it holds more than
+// the probe share of the point's light, and only then; the evaluator's share is half its
+// error ratio (groupProbeShare), so an unprobed hidden group costs at most that much.
+TEST(Reconstruction, AHiddenGroupIsCaughtWhenItHoldsMoreThanTheProbeShare) {
+  Fixture f;
+  // Just under the cloud, where one group holds a few per cent of the light.
+  ShadingPoint sp = point(Vec3(0.2f, 2, 0.1f));
+  CutRecord r = f.record(sp, open);
+  const CutRecord* four[4] = {&r, &r, &r, &r};
+  MergedCut m;
+  f.lc->mergeSamples(four, 4, m);
+  ASSERT_GE(m.groupProbe.size(), 2u);
+  CountingVisibility all(open);
+  EvalStats st;
+  const float total = luminance(evaluateMergedCut(f.lights, m, sp, all, st, 0.0f).radiance);
+  // The dimmest group with some light: the one a thin shadow hides.
+  constexpr size_t kBlocks = MergedCut::kGroupSize / 4;
+  size_t hiddenGroup = 0;
+  float groupLight = kInf;
+  for (size_t g = 0; g < m.groupProbe.size(); ++g) {
+    const float l = luminance(evaluateBatch(m.batch, sp, g * kBlocks, (g + 1) * kBlocks));
+    if (l > 0 && l < groupLight) groupLight = l, hiddenGroup = g;
+  }
+  const float share = groupLight / total;
+  // Between half the default error ratio and the 4% the probe once needed.
+  ASSERT_GT(share, 0.01f);
+  ASSERT_LT(share, 0.04f);
+  std::vector<Vec3> hiddenDirs;
+  for (size_t i = hiddenGroup * MergedCut::kGroupSize;
+       i < std::min(m.batchNodes.size(), (hiddenGroup + 1) * MergedCut::kGroupSize); ++i)
+    hiddenDirs.push_back(normalize(f.lights.lights[m.nodes[m.batchNodes[i]].rep].position - sp.p));
+  auto shadowed = [&](const Vec3& wi) {
+    for (const Vec3& d : hiddenDirs)
+      if (dot(wi, d) > 0.99999f) return Color(0);
+    return Color(1);
+  };
+  auto evaluate = [&](float probeShare, EvalStats& s) {
+    CountingVisibility v(shadowed);
+    return luminance(evaluateMergedCut(f.lights, m, sp, v, s, probeShare).radiance);
+  };
+  EvalStats caught, missed;
+  EXPECT_NEAR(evaluate(0.99f * share, caught), total - groupLight, 1e-3f * total);
+  EXPECT_GE(caught.failedGroupProbes, 1u);
+  EXPECT_NEAR(evaluate(1.01f * share, missed), total, 1e-4f * total);
+  EXPECT_EQ(missed.failedGroupProbes, 0u);
+  // Through the evaluator, at its error ratio: caught when the group holds over half of it.
+  EXPECT_EQ(groupProbeShare(0.02f), 0.01f);
+  CountingVisibility v(shadowed);
+  EvalStats s;
+  const float viaCut = luminance(f.lc->reconstruct(sp, v, s, m).radiance);
+  EXPECT_NEAR(viaCut, total - groupLight, 1e-3f * total);
 }
 
 TEST(Reconstruction, SamplesThatDisagreeSendTheRayAndAgreeingOnesDoNot) {
