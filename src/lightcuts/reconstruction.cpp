@@ -167,6 +167,8 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       }
       if (count > 0 && occluded == count) {
         ++out.occluded;
+        if (tree.type == LightType::Omni || tree.type == LightType::Oriented)
+          out.hidden.push_back(MergedCut::Node{n.intensity, n.rep, 0, true, true, false, 1.0f, t, it.node});
         continue;
       }
       bool needsRay = occluded > 0 || partial > 0 || visible == 0;
@@ -198,6 +200,19 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       if (luminance(out.nodes[out.batchNodes[i]].intensity) > luminance(out.nodes[best].intensity))
         best = out.batchNodes[i];
     out.groupProbe.push_back(best);
+  }
+  const size_t hiddenCount = out.hidden.size();
+  for (size_t g = 0; g < hiddenCount; g += MergedCut::kGroupSize) {
+    uint32_t best = uint32_t(g);
+    float sum = 0;
+    for (size_t i = g; i < std::min(hiddenCount, g + MergedCut::kGroupSize); ++i) {
+      sum += luminance(out.hidden[i].intensity);
+      if (luminance(out.hidden[i].intensity) > luminance(out.hidden[best].intensity)) best = uint32_t(i);
+    }
+    MergedCut::Node& probe = out.hidden[best];
+    probe.group = lights.lights[probe.rep].group;
+    out.hiddenProbe.push_back(best);
+    out.hiddenScale.push_back(luminance(probe.intensity) > 0 ? sum / luminance(probe.intensity) : 0.0f);
   }
 }
 
@@ -271,6 +286,27 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
     total -= groupSum[g];
     for (size_t i = g * MergedCut::kGroupSize; i < std::min(cut.batchNodes.size(), (g + 1) * MergedCut::kGroupSize); ++i)
       total += withRay(lights, cut.nodes[cut.batchNodes[i]], sp, vis, stats);
+  }
+  // A hidden group that would hold a share worth checking (of the point's light, or of the
+  // cut's error floor where the point is dark) gets its probe's ray; visible, the group's
+  // nodes get one each.
+  const float worthHidden = probeShare * std::max(luminance(total), sp.errorFloor);
+  for (size_t g = 0; g < cut.hiddenProbe.size(); ++g) {
+    const MergedCut::Node& probe = cut.hidden[cut.hiddenProbe[g]];
+    Color mg;
+    Vec3 wi;
+    float dist;
+    if (!lightContribution(lights.lights[probe.rep], lights.groups[probe.group], sp, mg, wi, dist)) continue;
+    if (!(luminance(mg * probe.intensity) * cut.hiddenScale[g] > worthHidden)) continue;
+    ++stats.shadowRays;
+    ++stats.groupProbes;
+    if (isBlack(vis(wi, dist))) continue;
+    ++stats.failedGroupProbes;
+    for (size_t i = g * MergedCut::kGroupSize; i < std::min(cut.hidden.size(), (g + 1) * MergedCut::kGroupSize); ++i) {
+      MergedCut::Node node = cut.hidden[i];  // its group is looked up only now
+      node.group = uint16_t(lights.lights[node.rep].group);
+      total += withRay(lights, node, sp, vis, stats);
+    }
   }
   uint32_t cutSize = uint32_t(cut.nodes.size()) + cut.occluded;
   stats.recordCut(cutSize);

@@ -4,7 +4,8 @@
 // ray of each node's representative found. A point between samples then walks the light
 // tree top down and, at each node, looks at what its samples did there:
 //   - some sample refined the node (its cut lies below): descend to the children;
-//   - every sample kept the node (or an ancestor) and found it occluded: it contributes 0;
+//   - every sample kept the node (or an ancestor) and found it occluded: it contributes 0
+//     (unless a probe finds its group visible at the point: MergedCut::hidden);
 //   - every sample kept it and found it visible (or had nothing to test): the node's
 //     estimate at this point, without a shadow ray;
 //   - the samples disagree, or the path went through glass: the estimate with one shadow
@@ -97,12 +98,23 @@ struct MergedCut {
   static constexpr uint32_t kGroupSize = 32;  // eight blocks
   std::vector<uint32_t> batchNodes;  // per batched node: its index in `nodes`
   std::vector<uint32_t> groupProbe;  // per group: the index in `nodes` of its probe
+  // The nodes every sample found occluded (omni and oriented lights; the others are only
+  // counted in `occluded`), batched and grouped the same way, in `hidden` order: a group
+  // that would hold over the probe share of a point's light sends its probe a ray, and if
+  // it is visible there, where no sample saw it, each node of the group gets its own (a
+  // gap between occluders thinner than the sample spacing).
+  std::vector<Node> hidden;
+  std::vector<uint32_t> hiddenProbe;  // per group: the index in `hidden` of its probe
+  std::vector<float> hiddenScale;     // per group: its intensity over its probe's (luminance)
   void clear() {
     nodes.clear();
     occluded = 0;
     batch.clear();
     batchNodes.clear();
     groupProbe.clear();
+    hidden.clear();
+    hiddenScale.clear();
+    hiddenProbe.clear();
   }
 };
 

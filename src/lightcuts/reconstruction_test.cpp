@@ -163,10 +163,11 @@ TEST(Reconstruction, ASampleRebuildsItsOwnLightcutWithoutShadowRays) {
   CountingVisibility v(halfBlocked);
   EvalStats st;
   EvalResult e = f.lc->reconstruct(sp, v, st, m);
-  // Every sample agrees on every node: the only rays are the group probes (none fails).
+  // Every sample agrees on every node: the only rays are the group probes, of the visible
+  // nodes and of the hidden ones (none fails).
   EXPECT_EQ(uint64_t(v.rays), st.groupProbes);
   EXPECT_EQ(st.failedGroupProbes, 0u);
-  EXPECT_LE(st.groupProbes, m.groupProbe.size());
+  EXPECT_LE(st.groupProbes, m.groupProbe.size() + m.hiddenProbe.size());
   EXPECT_EQ(e.cutSize, full.cutSize);
   EXPECT_NEAR(luminance(e.radiance), luminance(full.radiance), 1e-4f * luminance(full.radiance));
   EXPECT_EQ(st.reconstructedPoints, 1u);
@@ -226,6 +227,47 @@ TEST(Reconstruction, AHiddenGroupIsCaughtWhenItHoldsMoreThanTheProbeShare) {
   EXPECT_NEAR(viaCut, total - groupLight, 1e-3f * total);
 }
 
+// A group of nodes that every sample found occluded but the point sees (a gap between
+// occluders thinner than the sample spacing) is caught by its probe when it would hold over
+// the probe share of the point's light; unprobed, its light is missing.
+TEST(Reconstruction, AGroupTheSamplesFoundHiddenButThePointSeesIsCaught) {
+  Fixture f;
+  ShadingPoint sp = point(Vec3(0.2f, 2, 0.1f));
+  CutRecord r = f.record(sp, halfBlocked);
+  const CutRecord* four[4] = {&r, &r, &r, &r};
+  MergedCut m;
+  f.lc->mergeSamples(four, 4, m);
+  ASSERT_GE(m.hiddenProbe.size(), 2u);
+  EXPECT_EQ(m.hidden.size(), size_t(m.occluded));  // every node here is an omni light's
+  // The point sees the first hidden group's lights besides what the samples saw.
+  std::vector<Vec3> gap;
+  double gapLight = 0;
+  for (size_t i = 0; i < std::min<size_t>(m.hidden.size(), MergedCut::kGroupSize); ++i) {
+    const Light& l = f.lights.lights[m.hidden[i].rep];
+    Color mg;
+    Vec3 wi;
+    float dist;
+    if (!lightContribution(l, f.lights.groups[l.group], sp, mg, wi, dist)) continue;
+    gap.push_back(wi);
+    gapLight += luminance(mg * m.hidden[i].intensity);
+  }
+  ASSERT_GT(gapLight, 0.0);
+  auto seen = [&](const Vec3& wi) {
+    for (const Vec3& d : gap)
+      if (dot(wi, d) > 0.99999f) return Color(1);
+    return halfBlocked(wi);
+  };
+  auto evaluate = [&](float probeShare, EvalStats& s) {
+    CountingVisibility v(seen);
+    return luminance(evaluateMergedCut(f.lights, m, sp, v, s, probeShare).radiance);
+  };
+  EvalStats missed, caught;
+  const float without = evaluate(1e30f, missed);  // no group probed
+  EXPECT_EQ(missed.groupProbes, 0u);
+  EXPECT_NEAR(evaluate(0.0f, caught), without + gapLight, 1e-3 * (without + gapLight));
+  EXPECT_GE(caught.failedGroupProbes, 1u);
+}
+
 TEST(Reconstruction, SamplesThatDisagreeSendTheRayAndAgreeingOnesDoNot) {
   Fixture f;
   ShadingPoint sp = point(Vec3(0.2f, 0, 0.1f));
@@ -241,14 +283,15 @@ TEST(Reconstruction, SamplesThatDisagreeSendTheRayAndAgreeingOnesDoNot) {
   EXPECT_EQ(size_t(v.rays), needRay + st.groupProbes);
   EXPECT_EQ(st.shadowRays, needRay + st.groupProbes);
 
-  // Samples that saw nothing: the point is dark, at no cost.
+  // Samples that saw nothing: a point that sees nothing either is dark, for at most one
+  // probe ray per group of hidden nodes.
   CutRecord c = f.record(sp, allBlocked);
   const CutRecord* one[1] = {&c};
   f.lc->mergeSamples(one, 1, m);
   EXPECT_TRUE(m.nodes.empty());
-  CountingVisibility o(open);
+  CountingVisibility o(allBlocked);
   EvalResult e = f.lc->reconstruct(sp, o, st, m);
-  EXPECT_EQ(o.rays, 0);
+  EXPECT_LE(size_t(o.rays), m.hiddenProbe.size());
   EXPECT_EQ(luminance(e.radiance), 0.0f);
 }
 
