@@ -24,8 +24,10 @@ struct EvalStats {
   uint64_t hiddenClusters = 0;       // clusters kept in a cut as hidden by their probes
   uint64_t clearTests = 0;           // clusters tested for being visible as a whole (boxClear)
   uint64_t clearedClusters = 0;      // those found so
-  uint64_t groupProbes = 0;          // rays testing groups of borrowed-visible nodes (reconstruction.h)
-  uint64_t failedGroupProbes = 0;    // those groups found hidden where every sample saw them
+  uint64_t groupProbes = 0;          // rays testing groups of borrowed nodes (reconstruction.h)
+  // Those that found the samples wrong: a group hidden where every sample saw it, or
+  // visible where every sample found it occluded (MergedCut::hidden).
+  uint64_t failedGroupProbes = 0;
   // Time, filled by the caller's Visibility and shading loop where they measure it:
   uint64_t tracedRays = 0;           // rays through the Visibility (shadow and probe rays)
   uint64_t timedRays = 0;            // a random sample of them, timed
