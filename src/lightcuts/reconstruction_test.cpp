@@ -64,6 +64,13 @@ struct Fixture {
     lc->mergeSamples(two, 2, m);
     return m;
   }
+  // The merged cut of four samples that agree on everything (one record four times).
+  MergedCut agreeing(const CutRecord& r) {
+    const CutRecord* four[4] = {&r, &r, &r, &r};
+    MergedCut m;
+    lc->mergeSamples(four, 4, m);
+    return m;
+  }
 };
 
 TEST(Reconstruction, PreorderMakesEverySubtreeAContiguousRange) {
@@ -154,10 +161,7 @@ TEST(Reconstruction, ASampleRebuildsItsOwnLightcutWithoutShadowRays) {
   Fixture f;
   ShadingPoint sp = point(Vec3(0.2f, 0, 0.1f));
   EvalResult full;
-  CutRecord r = f.record(sp, halfBlocked, &full);
-  const CutRecord* four[4] = {&r, &r, &r, &r};
-  MergedCut m;
-  f.lc->mergeSamples(four, 4, m);
+  MergedCut m = f.agreeing(f.record(sp, halfBlocked, &full));
   EXPECT_EQ(m.nodes.size() + m.occluded, full.cutSize);
   EXPECT_GT(m.occluded, 0u);
   CountingVisibility v(halfBlocked);
@@ -181,10 +185,7 @@ TEST(Reconstruction, AHiddenGroupIsCaughtWhenItHoldsMoreThanTheProbeShare) {
   Fixture f;
   // Just under the cloud, where one group holds a few per cent of the light.
   ShadingPoint sp = point(Vec3(0.2f, 2, 0.1f));
-  CutRecord r = f.record(sp, open);
-  const CutRecord* four[4] = {&r, &r, &r, &r};
-  MergedCut m;
-  f.lc->mergeSamples(four, 4, m);
+  MergedCut m = f.agreeing(f.record(sp, open));
   ASSERT_GE(m.groupProbe.size(), 2u);
   CountingVisibility all(open);
   EvalStats st;
@@ -233,10 +234,7 @@ TEST(Reconstruction, AHiddenGroupIsCaughtWhenItHoldsMoreThanTheProbeShare) {
 TEST(Reconstruction, AGroupTheSamplesFoundHiddenButThePointSeesIsCaught) {
   Fixture f;
   ShadingPoint sp = point(Vec3(0.2f, 2, 0.1f));
-  CutRecord r = f.record(sp, halfBlocked);
-  const CutRecord* four[4] = {&r, &r, &r, &r};
-  MergedCut m;
-  f.lc->mergeSamples(four, 4, m);
+  MergedCut m = f.agreeing(f.record(sp, halfBlocked));
   ASSERT_GE(m.hiddenProbe.size(), 2u);
   EXPECT_EQ(m.hidden.size(), size_t(m.occluded));  // every node here is an omni light's
   // The point sees the first hidden group's lights besides what the samples saw.
