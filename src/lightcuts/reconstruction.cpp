@@ -14,6 +14,30 @@ constexpr uint8_t kAbove = 0xff;  // the sample refined this node: its cut lies 
 // to the cluster (squared).
 constexpr float kCoarsenRatio2 = 8.0f * 8.0f;
 
+// M * G at sp of a merged-cut node's representative, per unit intensity (lightContribution).
+inline bool repContribution(const LightSet& lights, const MergedCut::Node& node, const ShadingPoint& sp, Color& mg,
+                            Vec3& wi, float& dist) {
+  const Light& l = lights.lights[node.rep];
+  return lightContribution(l, lights.groups[l.group], sp, mg, wi, dist);
+}
+
+// Cuts `count` nodes, in order, into groups of MergedCut::kGroupSize and appends each
+// group's brightest (by the luminance of its intensity, `lum(i)`; the first on a tie) to
+// `probe`, and, with `scale`, the group's summed luminance over the probe's.
+template <class Lum>
+void groupProbes(size_t count, Lum lum, std::vector<uint32_t>& probe, std::vector<float>* scale) {
+  for (size_t g = 0; g < count; g += MergedCut::kGroupSize) {
+    size_t best = g;
+    float sum = 0;
+    for (size_t i = g; i < std::min(count, g + MergedCut::kGroupSize); ++i) {
+      sum += lum(i);
+      if (lum(i) > lum(best)) best = i;
+    }
+    probe.push_back(uint32_t(best));
+    if (scale) scale->push_back(lum(best) > 0 ? sum / lum(best) : 0.0f);
+  }
+}
+
 inline float distance2Box(const LightNode& n, const Vec3& p) {
   Vec3 d = vmax(vmax(n.lo - p, p - n.hi), Vec3(0.0f));
   return dot(d, d);
@@ -168,7 +192,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       if (count > 0 && occluded == count) {
         ++out.occluded;
         if (tree.type == LightType::Omni || tree.type == LightType::Oriented)
-          out.hidden.push_back(MergedCut::Node{n.intensity, n.rep, 0, true, true, false, 1.0f, t, it.node});
+          out.hidden.push_back(MergedCut::Node{n.intensity, n.rep, true, false, false, 1.0f, t, it.node});
         continue;
       }
       bool needsRay = occluded > 0 || partial > 0 || visible == 0;
@@ -176,7 +200,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       const float factor = firstOrder == count && exacts > 0 ? factorSum / float(exacts) : 1.0f;
       const bool batched = !needsRay && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
       // The group and the batch wait for the pass below, which fetches the lights ahead.
-      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, 0, needsRay, batched, disagree, factor, t, it.node});
+      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, needsRay, batched, disagree, factor, t, it.node});
     }
   }
   // The representatives' lights are scattered over the light array: a cache miss each when
@@ -186,34 +210,18 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
   for (size_t i = 0; i < std::min(kAhead, nodeCount); ++i) __builtin_prefetch(&lights.lights[out.nodes[i].rep]);
   for (size_t i = 0; i < nodeCount; ++i) {
     if (i + kAhead < nodeCount) __builtin_prefetch(&lights.lights[out.nodes[i + kAhead].rep]);
-    MergedCut::Node& node = out.nodes[i];
+    const MergedCut::Node& node = out.nodes[i];
     const Light& rep = lights.lights[node.rep];
-    node.group = rep.group;
     if (node.batched) {
       out.batch.add(rep, lights.groups[rep.group], node.intensity * node.factor);
       out.batchNodes.push_back(uint32_t(i));
     }
   }
-  for (size_t g = 0; g < out.batchNodes.size(); g += MergedCut::kGroupSize) {
-    uint32_t best = out.batchNodes[g];
-    for (size_t i = g; i < std::min(out.batchNodes.size(), g + MergedCut::kGroupSize); ++i)
-      if (luminance(out.nodes[out.batchNodes[i]].intensity) > luminance(out.nodes[best].intensity))
-        best = out.batchNodes[i];
-    out.groupProbe.push_back(best);
-  }
-  const size_t hiddenCount = out.hidden.size();
-  for (size_t g = 0; g < hiddenCount; g += MergedCut::kGroupSize) {
-    uint32_t best = uint32_t(g);
-    float sum = 0;
-    for (size_t i = g; i < std::min(hiddenCount, g + MergedCut::kGroupSize); ++i) {
-      sum += luminance(out.hidden[i].intensity);
-      if (luminance(out.hidden[i].intensity) > luminance(out.hidden[best].intensity)) best = uint32_t(i);
-    }
-    MergedCut::Node& probe = out.hidden[best];
-    probe.group = lights.lights[probe.rep].group;
-    out.hiddenProbe.push_back(best);
-    out.hiddenScale.push_back(luminance(probe.intensity) > 0 ? sum / luminance(probe.intensity) : 0.0f);
-  }
+  groupProbes(out.batchNodes.size(), [&](size_t i) { return luminance(out.nodes[out.batchNodes[i]].intensity); },
+              out.groupProbe, nullptr);
+  for (uint32_t& p : out.groupProbe) p = out.batchNodes[p];  // an index into `nodes`
+  groupProbes(out.hidden.size(), [&](size_t i) { return luminance(out.hidden[i].intensity); }, out.hiddenProbe,
+              &out.hiddenScale);
 }
 
 float disagreementShare(const LightSet& lights, const MergedCut& cut, const Vec3& p, const Vec3& n) {
@@ -228,7 +236,7 @@ float disagreementShare(const LightSet& lights, const MergedCut& cut, const Vec3
     Color mg;
     Vec3 wi;
     float dist;
-    if (!lightContribution(lights.lights[node.rep], lights.groups[node.group], sp, mg, wi, dist)) continue;
+    if (!repContribution(lights, node, sp, mg, wi, dist)) continue;
     const double c = luminance(mg * node.intensity);
     all += c;
     if (node.disagree) disagreeing += c;
@@ -245,11 +253,21 @@ Color withRay(const LightSet& lights, const MergedCut::Node& node, const Shading
   Color mg;
   Vec3 wi;
   float dist;
-  if (!lightContribution(lights.lights[node.rep], lights.groups[node.group], sp, mg, wi, dist)) return Color(0);
+  if (!repContribution(lights, node, sp, mg, wi, dist)) return Color(0);
   ++stats.shadowRays;
   Color v = vis(wi, dist);
   float f = v.x == 1 && v.y == 1 && v.z == 1 ? node.factor : 1.0f;
   return mg * v * (node.intensity * f);
+}
+
+// A group probe's ray toward wi: whether it finds the group otherwise than every sample
+// did (hidden where they saw it, `samplesSaw`, or visible where none did).
+bool probeContradicts(const Vec3& wi, float dist, bool samplesSaw, Visibility& vis, EvalStats& stats) {
+  ++stats.shadowRays;
+  ++stats.groupProbes;
+  if (isBlack(vis(wi, dist)) != samplesSaw) return false;
+  ++stats.failedGroupProbes;
+  return true;
 }
 
 }  // namespace
@@ -274,15 +292,12 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
   const float worth = probeShare * luminance(total);
   for (size_t g = 0; g < groups; ++g) {
     if (!(luminance(groupSum[g]) > worth)) continue;
-    const MergedCut::Node& probe = cut.nodes[cut.groupProbe[g]];
     Color mg;
     Vec3 wi;
     float dist;
-    if (!lightContribution(lights.lights[probe.rep], lights.groups[probe.group], sp, mg, wi, dist)) continue;
-    ++stats.shadowRays;
-    ++stats.groupProbes;
-    if (!isBlack(vis(wi, dist))) continue;
-    ++stats.failedGroupProbes;
+    if (!repContribution(lights, cut.nodes[cut.groupProbe[g]], sp, mg, wi, dist) ||
+        !probeContradicts(wi, dist, true, vis, stats))
+      continue;
     total -= groupSum[g];
     for (size_t i = g * MergedCut::kGroupSize; i < std::min(cut.batchNodes.size(), (g + 1) * MergedCut::kGroupSize); ++i)
       total += withRay(lights, cut.nodes[cut.batchNodes[i]], sp, vis, stats);
@@ -296,17 +311,12 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
     Color mg;
     Vec3 wi;
     float dist;
-    if (!lightContribution(lights.lights[probe.rep], lights.groups[probe.group], sp, mg, wi, dist)) continue;
-    if (!(luminance(mg * probe.intensity) * cut.hiddenScale[g] > worthHidden)) continue;
-    ++stats.shadowRays;
-    ++stats.groupProbes;
-    if (isBlack(vis(wi, dist))) continue;
-    ++stats.failedGroupProbes;
-    for (size_t i = g * MergedCut::kGroupSize; i < std::min(cut.hidden.size(), (g + 1) * MergedCut::kGroupSize); ++i) {
-      MergedCut::Node node = cut.hidden[i];  // its group is looked up only now
-      node.group = uint16_t(lights.lights[node.rep].group);
-      total += withRay(lights, node, sp, vis, stats);
-    }
+    if (!repContribution(lights, probe, sp, mg, wi, dist) ||
+        !(luminance(mg * probe.intensity) * cut.hiddenScale[g] > worthHidden) ||
+        !probeContradicts(wi, dist, false, vis, stats))
+      continue;
+    for (size_t i = g * MergedCut::kGroupSize; i < std::min(cut.hidden.size(), (g + 1) * MergedCut::kGroupSize); ++i)
+      total += withRay(lights, cut.hidden[i], sp, vis, stats);
   }
   uint32_t cutSize = uint32_t(cut.nodes.size()) + cut.occluded;
   stats.recordCut(cutSize);

@@ -74,8 +74,7 @@ struct CutRecord {
 struct MergedCut {
   struct Node {
     Color intensity;  // the node's summed intensity
-    uint32_t rep;     // its representative light
-    uint16_t group;
+    uint32_t rep;     // its representative light (whose group it lights with)
     bool needsRay;    // the samples disagree, went through glass, or tested nothing
     bool batched;     // also in `batch` (no ray, an omni or oriented light)
     // The samples disagree about its visibility (some found it occluded, some not), or saw
@@ -99,10 +98,11 @@ struct MergedCut {
   std::vector<uint32_t> batchNodes;  // per batched node: its index in `nodes`
   std::vector<uint32_t> groupProbe;  // per group: the index in `nodes` of its probe
   // The nodes every sample found occluded (omni and oriented lights; the others are only
-  // counted in `occluded`), batched and grouped the same way, in `hidden` order: a group
-  // that would hold over the probe share of a point's light sends its probe a ray, and if
-  // it is visible there, where no sample saw it, each node of the group gets its own (a
-  // gap between occluders thinner than the sample spacing).
+  // counted in `occluded`), in groups of kGroupSize in the walk's order, each with its
+  // brightest node as probe: a group whose light at a point (its probe's times hiddenScale)
+  // would be over the probe share sends the probe a ray, and if it is visible there, where
+  // no sample saw it, each node of the group gets its own (a gap between occluders thinner
+  // than the sample spacing).
   std::vector<Node> hidden;
   std::vector<uint32_t> hiddenProbe;  // per group: the index in `hidden` of its probe
   std::vector<float> hiddenScale;     // per group: its intensity over its probe's (luminance)
