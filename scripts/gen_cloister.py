@@ -16,7 +16,7 @@ import random
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gen_scaling_scene import parse_count  # noqa: E402
+from gen_scaling_scene import count_and_output  # noqa: E402
 from gen_scenes import box, material, num  # noqa: E402
 
 L, W, H = 24.0, 4.0, 4.5   # corridor: z in [-L/2, L/2], x in [0, W], y in [0, H]
@@ -30,10 +30,7 @@ def light(x, y, z, c):
 
 
 def main(argv):
-    if len(argv) not in (2, 3):
-        sys.exit(__doc__)
-    n = parse_count(argv[1]) if len(argv) == 3 else 12000
-    out = argv[-1]
+    n, out = count_and_output(argv, 12000, __doc__)
     rng = random.Random(1207)
     stone = material(diffuse=(0.62, 0.58, 0.5))
     floor = material(diffuse=(0.45, 0.4, 0.35), specular=(0.1, 0.1, 0.1), shininess=30)

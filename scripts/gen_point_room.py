@@ -14,7 +14,7 @@ import random
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gen_scaling_scene import parse_count  # noqa: E402
+from gen_scaling_scene import count_and_output  # noqa: E402
 from gen_scenes import box, material, num  # noqa: E402
 
 W, H, D = 12.0, 4.0, 12.0   # room: x in [-W/2, W/2], y in [0, H], z in [-D/2, D/2]
@@ -23,10 +23,7 @@ CLUSTERS = 24
 
 
 def main(argv):
-    if len(argv) not in (2, 3):
-        sys.exit(__doc__)
-    n = parse_count(argv[1]) if len(argv) == 3 else 100000
-    out = argv[-1]
+    n, out = count_and_output(argv, 100000, __doc__)
     rng = random.Random(21)
     centres = [(rng.uniform(-W / 2 + 1, W / 2 - 1), rng.uniform(2.6, 3.5), rng.uniform(-D / 2 + 1, D / 2 - 1))
                for _ in range(CLUSTERS)]

@@ -35,6 +35,14 @@ def parse_count(s):
     return n
 
 
+def count_and_output(argv, default, doc):
+    """The arguments `[N] OUT.ray` of a many-light scene generator: (N, OUT); the usage
+    (`doc`) and exit when they are not that."""
+    if len(argv) not in (2, 3):
+        sys.exit(doc)
+    return (parse_count(argv[1]) if len(argv) == 3 else default), argv[-1]
+
+
 def scene(n):
     n -= n % 2
     panels = GRID * GRID
