@@ -473,7 +473,7 @@ TEST(CliUsage, RenderHelpIsGroupedAndStatesEveryDefault) {
   for (const char* name :
        {"-o,--output", "--stats", "--cut-heatmap", "--tonemap", "--exposure", "-q,--quiet", "--width", "--height", "--spp",
         "--max-depth", "--threads", "--seed", "--method", "--tree", "--error", "--max-cut", "--cut-criterion",
-        "--estimator", "--visibility-probes", "--clear-clusters", "--reference-pixels", "--reconstruct", "--reconstruct-coarse",
+        "--estimator", "--visibility-probes", "--clear-clusters", "--reference-pixels", "--reconstruct", "--reconstruct-coarse", "--reconstruct-split",
         "--lenient", "--object-lights", "--object-light-placement", "--emission-density", "--default-attenuation",
         "--vpls", "--bounces", "--vpl-normalize", "--vpl-clamp", "--caustics", "--caustic-lights",
         "--caustic-smoothing", "--gi", "--max-lights", "--max-vpls",

@@ -40,6 +40,7 @@ struct RenderArgs {
   std::string errorFloor = "auto";
   std::string reconstruct = "auto";
   std::string reconstructCoarse = "auto";
+  float reconstructSplit = render::RenderOptions{}.reconstructSplit;
   // 8-bit output is display-ready by default (writeImage's own default is Clamp).
   io::ToneMap tonemap = io::ToneMap::Srgb;
   float exposure = 0;  // EV: 8-bit outputs scale linear values by 2^exposure

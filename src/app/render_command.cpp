@@ -311,6 +311,7 @@ render::RenderOptions renderOptions(const RenderArgs& a, lightcuts::Method metho
   ro.errorFloor = a.errorFloor == "auto" ? -1.0f : std::stof(a.errorFloor);
   ro.reconstructSpacing = method == lightcuts::Method::Lightcuts ? reconstructSpacing(a.reconstruct, a.width, a.height) : 0;
   ro.reconstructCoarseSpacing = reconstructCoarseSpacing(a.reconstructCoarse, ro.reconstructSpacing);
+  ro.reconstructSplit = a.reconstructSplit;
   return ro;
 }
 
@@ -665,6 +666,14 @@ void addRenderCommand(CLI::App& app) {
                             "times a power of two, 0 = off; default {} = {}N",
                             d.reconstructCoarse, kAutoCoarseFactor))
       ->check(CLI::IsMember({"auto"}) | CLI::Range(0, 1 << 16))
+      ->group(recon);
+  c->add_option("--reconstruct-split", a->reconstructSplit,
+                fmt::format("Reconstruction cuts: a cell of N pixels or less whose corner samples lie on one surface "
+                            "splits in four (new samples) when the lights they disagree about hold more than this share "
+                            "of their light: dense shadow edges, where thin shadows between the samples are likely; "
+                            "1 = never; default {}",
+                            d.reconstructSplit))
+      ->check(CLI::Range(0.0f, 1.0f))
       ->group(recon);
   addSceneOptions(*c, a->load);
   c->callback([a] {

@@ -74,6 +74,7 @@ nlohmann::json renderCountersJson(const render::RenderStats& st) {
   j["reconstruction_samples"] = st.reconstructionSamples;
   j["reconstruction_fallbacks"] = st.reconstructionFallbacks;
   j["reconstruction_coarse_cells"] = st.reconstructionCoarseCells;
+  j["reconstruction_split_cells"] = st.reconstructionSplitCells;
   j["aa_pixels"] = st.aaPixels;
   j["aa_seam_pixels"] = st.aaSeamPixels;
   j["aa_sub_samples"] = st.aaSubSamples;
@@ -90,6 +91,7 @@ void addRenderCounters(render::RenderStats& st, const nlohmann::json& j) {
   st.reconstructionSamples += j.at("reconstruction_samples").get<uint64_t>();
   st.reconstructionFallbacks += j.at("reconstruction_fallbacks").get<uint64_t>();
   st.reconstructionCoarseCells += j.at("reconstruction_coarse_cells").get<uint64_t>();
+  st.reconstructionSplitCells += j.at("reconstruction_split_cells").get<uint64_t>();
   st.aaPixels += j.at("aa_pixels").get<uint64_t>();
   st.aaSeamPixels += j.at("aa_seam_pixels").get<uint64_t>();
   st.aaSubSamples += j.at("aa_sub_samples").get<uint64_t>();
@@ -183,6 +185,8 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["reconstructed_points"] = es.reconstructedPoints;
   j["reconstruction_fallbacks"] = rr.stats.reconstructionFallbacks;
   j["reconstruction_coarse_cells"] = rr.stats.reconstructionCoarseCells;
+  j["reconstruct_split"] = ro.reconstructSplit;
+  j["reconstruction_split_cells"] = rr.stats.reconstructionSplitCells;
   j["max_depth"] = a.maxDepth;
   j["tonemap"] = io::toneMapName(a.tonemap);
   j["exposure"] = a.exposure;
@@ -300,11 +304,14 @@ void printRenderSummary(const RenderReport& r) {
                threads, threads == 1 ? "" : "s", tiles, busy, 100 * r.loadBalance);
   }
   if (ro.reconstructSpacing > 1)
-    fmt::print("recon.     full lightcuts every {} pixels ({} samples{}); {} points rebuilt from them, {} got full cuts\n",
+    fmt::print("recon.     full lightcuts every {} pixels ({} samples{}{}); {} points rebuilt from them, {} got full cuts\n",
                ro.reconstructSpacing, formatCount(double(rr.stats.reconstructionSamples)),
                ro.reconstructCoarseSpacing > 0
                    ? fmt::format("; {} cells of {} kept whole where their samples agree",
                                  formatCount(double(rr.stats.reconstructionCoarseCells)), ro.reconstructCoarseSpacing)
+                   : std::string(),
+               rr.stats.reconstructionSplitCells > 0
+                   ? fmt::format("; {} split where they disagree", formatCount(double(rr.stats.reconstructionSplitCells)))
                    : std::string(),
                formatCount(double(es.reconstructedPoints)), formatCount(double(rr.stats.reconstructionFallbacks)));
   fmt::print("time       {} total: load {}, accel {}, lights {}, tree {}, render {}{}\n", formatSeconds(r.totalSeconds),

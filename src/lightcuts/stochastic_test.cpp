@@ -46,7 +46,9 @@ TEST(StochasticLightcuts, MeanOfManyDrawsIsBruteForce) {
       EXPECT_NEAR(mean, exact, 4 * stderr_ + 1e-6 * exact) << "mean " << mean << " exact " << exact;
       // Larger cuts draw fewer lights per cluster: less spread (not a property of a single
       // draw, but of the estimator; 64 clusters of ~50 lights vs one of 3000).
-      if (cut == 64) EXPECT_LT(std::sqrt(var), 0.5 * exact);
+      if (cut == 64) {
+        EXPECT_LT(std::sqrt(var), 0.5 * exact);
+      }
     }
   }
 }

@@ -30,6 +30,8 @@ Loaded loadCornell() {
   return l;
 }
 
+// (Reconstruction cells here split only where their samples cannot serve a pixel, not for
+// disagreeing: at 64 pixels a cell of 4 spans a sixteenth of the box, and most would.)
 RenderResult renderWith(const scene::Scene& s, const lightcuts::LightEvaluator& ev, int w, int reconstruct = 0,
                         int coarse = 0) {
   RenderOptions o;
@@ -37,6 +39,7 @@ RenderResult renderWith(const scene::Scene& s, const lightcuts::LightEvaluator& 
   o.width = o.height = w;
   o.reconstructSpacing = reconstruct;
   o.reconstructCoarseSpacing = coarse;
+  o.reconstructSplit = 1;
   return render(s, ev, o);
 }
 
@@ -208,6 +211,50 @@ TEST(Accuracy, ReconstructionCutsWithinTwoPercentWithFarFewerShadowRays) {
   EXPECT_GT(coarse.stats.reconstructionCoarseCells, 0u);
   EXPECT_LT(coarse.stats.reconstructionSamples, rec.stats.reconstructionSamples);
   for (uint8_t d : coarse.done) ASSERT_EQ(d, 1);
+}
+
+
+// A floor seen from above under a row of thin slats, lit by lights scattered above them:
+// each light lays a slat's shadow, narrower than a pixel, somewhere else on the floor, so
+// the floor is striped with shadows that fall between samples four pixels apart. There
+// the samples disagree about much of their light, and a cell that splits where they do
+// (RenderOptions::reconstructSplit) finds the stripes all four of its corners stepped over.
+std::string slatFloor(uint32_t seed, int lights) {
+  std::mt19937 rng(seed);
+  auto u = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
+  std::string t = "SBT-raytracer 1.0\ncamera { position = (0, 3, 0.01); look_at = (0, 0, 0); fov = 45; }\n";
+  t += "translate(0, -0.05, 0, scale(4, 0.1, 4, box { material = { diffuse = (0.6, 0.6, 0.6); }; }))\n";
+  for (int k = 0; k < 9; ++k)
+    t += "translate(" + std::to_string(-1.2f + 0.3f * float(k)) +
+         ", 0.25, 0, scale(0.03, 0.03, 3, box { material = { diffuse = (0.3, 0.3, 0.3); }; }))\n";
+  for (int i = 0; i < lights; ++i)
+    t += "point_light { position = (" + std::to_string(u(-2, 2)) + "," + std::to_string(u(0.8f, 1.6f)) + "," +
+         std::to_string(u(-2, 2)) + "); colour = (" + std::to_string(2.0f / float(lights)) + "," +
+         std::to_string(2.0f / float(lights)) + "," + std::to_string(2.0f / float(lights)) + "); }\n";
+  return t;
+}
+
+TEST(Accuracy, CellsSplitWhereTheirSamplesDisagreeCatchShadowsBetweenThem) {
+  auto s = scene::Scene::build(io::parseRayString(slatFloor(5, 400), "slats.ray", "."));
+  auto brute = lightcuts::makeBruteForce(s->lights());
+  lightcuts::LightForest forest = lightcuts::buildLightForest(s->lights());
+  auto lc = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
+  RenderOptions o;
+  o.aa = AntiAliasing::Off;
+  o.width = o.height = 64;
+  o.reconstructSpacing = 4;
+  RenderResult ref = render(*s, *brute, o);
+  o.reconstructSplit = 1;  // never split: the stripes between samples are missed
+  RenderResult whole = render(*s, *lc, o);
+  o.reconstructSplit = RenderOptions{}.reconstructSplit;
+  RenderResult split = render(*s, *lc, o);
+  const io::ImageMetrics mw = io::compareImages(ref.image, whole.image), ms = io::compareImages(ref.image, split.image);
+  EXPECT_EQ(whole.stats.reconstructionSplitCells, 0u);
+  EXPECT_GT(split.stats.reconstructionSplitCells, 0u);
+  EXPECT_GT(split.stats.reconstructionSamples, whole.stats.reconstructionSamples);
+  EXPECT_GT(mw.fraction_over_threshold, 0.02) << "mean " << mw.mean_relative_error;
+  EXPECT_LE(ms.fraction_over_threshold, 0.01) << "mean " << ms.mean_relative_error << " p99 " << ms.p99_relative_error;
+  for (uint8_t d : split.done) ASSERT_EQ(d, 1);
 }
 
 }  // namespace

@@ -219,10 +219,10 @@ void ReconstructionTile::run() {
     for (int cx = x0_; cx < x1_; cx += C) cellPixels(cx, cy, std::min(C, x1_ - cx), std::min(C, y1_ - cy));
 }
 
-// Whether a coarse cell may be rebuilt whole: four corners on one surface, the nodes they
-// disagree about holding at most kCoarseMaxDisagreement of their merged cut's light (the
-// merged cut is made here and kept for the cell's pixels).
-bool ReconstructionTile::coarseAgrees(const CutSample* const* corners, int n) {
+// Whether a cell may be rebuilt whole: four corners on one surface, the nodes they disagree
+// about holding at most `limit` of their merged cut's light (the merged cut is made here and
+// kept for the cell's pixels: cell.ready[15] says whether the corners were on one surface).
+bool ReconstructionTile::cornersAgree(const CutSample* const* corners, int n, float limit) {
   if (n != 4) return false;
   for (int i = 0; i < 4; ++i) {
     if (!corners[i]->cut.valid) return false;
@@ -236,7 +236,7 @@ bool ReconstructionTile::coarseAgrees(const CutSample* const* corners, int n) {
   lightcuts::MergedCut& merged = scratch_.cell.merged[15];
   r_.cuts.merge(cuts, 4, merged);
   scratch_.cell.ready[15] = true;
-  return r_.cuts.disagreement(merged, corners[0]->p, corners[0]->n) <= kCoarseMaxDisagreement;
+  return r_.cuts.disagreement(merged, corners[0]->p, corners[0]->n) <= limit;
 }
 
 // The surface a pixel centre's ray shades (false: none).
@@ -288,7 +288,16 @@ void ReconstructionTile::cellPixels(int cx, int cy, int w, int h) {
   // The footprint limit grows with the cell (a coarse cell's points lie farther from
   // its corners), so on a surface seen face on the cell stays whole.
   hook.maxSeparation = coarse ? maxSeparation_ * float(std::max(w, h)) / float(spacing) : maxSeparation_;
-  const bool split = coarse && !coarseAgrees(corners, n);  // at once: its pixels wait for finer cells
+  // At once: its pixels wait for finer cells. A coarse cell splits unless its corners
+  // agree; a smaller one (of four corners) when they lie on one surface and disagree about
+  // much of their light (RenderOptions::reconstructSplit).
+  bool split = false;
+  if (coarse) {
+    split = !cornersAgree(corners, n, kCoarseMaxDisagreement);
+  } else if (o_.reconstructSplit < 1 && (w > 1 || h > 1)) {
+    split = !cornersAgree(corners, n, o_.reconstructSplit) && cell.ready[15];  // ready: on one surface
+    n_.splitCells += split;
+  }
   bool left = split;  // pixels this cell's samples cannot serve
   n_.coarseCells += coarse && !split;
   for (int y = cy; y < cy + h && !split; ++y)

@@ -194,7 +194,9 @@ struct ReconstructionScratch {
 // inside the samples on its surface (servingSamples) is rebuilt from them; where some are
 // not, the cell splits in four, with new samples on the corners of the parts, down to
 // single pixels: samples gather along edges and silhouettes, smooth regions share a few
-// (the adaptive image sampling of Walter et al. 2005, sec. 5). Every choice depends only
+// (the adaptive image sampling of Walter et al. 2005, sec. 5). A cell also splits where
+// its corners disagree about much of their light (RenderOptions::reconstructSplit), so
+// samples gather where shadow edges are dense too. Every choice depends only
 // on the hits, so the image does not depend on the order tiles run in. Corners on the
 // tile's right and bottom edges belong to the next tiles; they are shared with them
 // (EdgeSamples) and stored by the tile they belong to.
@@ -223,7 +225,7 @@ class ReconstructionTile {
  private:
   size_t slot(int x, int y) const { return size_t(y - y0_) * size_t(x1_ - x0_ + 1) + size_t(x - x0_); }
   const CutSample& sample(int x, int y);
-  bool coarseAgrees(const CutSample* const* corners, int n);
+  bool cornersAgree(const CutSample* const* corners, int n, float limit);
   bool probe(int x, int y, int& shape, Vec3& p, Vec3& n) const;
   void cellPixels(int cx, int cy, int w, int h);
 

@@ -253,6 +253,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     res.stats.reconstructionSamples += n.samples;
     res.stats.reconstructionFallbacks += n.fallbacks;
     res.stats.reconstructionCoarseCells += n.coarseCells;
+    res.stats.reconstructionSplitCells += n.splitCells;
     res.stats.tiles += n.tiles;
     res.stats.pixels += n.pixels;
     res.stats.aaPixels += n.aaPixels;
