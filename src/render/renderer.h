@@ -108,10 +108,11 @@ struct RenderOptions {
   // disagree about hold more than this share of their merged cut's unshadowed light: shadow
   // boundaries cross it densely, and there a shadow thinner than the spacing, which all
   // four corners miss, is likely (thin shelves and posts). Those nodes get a ray at every
-  // point of the cell anyway, so its samples cost little more. 1 = never. 0.2 was measured:
-  // an unseen warehouse of thin shelves from 1.83% to 0.95% of pixels over 2%, the suite's
-  // interiors no worse, their shadow rays per point within 3% (docs/BENCHMARKS.md, "Cells
-  // split where their samples disagree").
+  // point of the cell anyway, so its samples cost few more rays (more bounds work). 1 =
+  // never. 0.2 was measured: unseen warehouses of thin shelves from 1.83% and 1.68% to 0.95%
+  // and 0.83% of pixels over 2%, the suite's interiors no worse, shadow rays per point -8%
+  // to +7%, render time +4% to +19% (docs/BENCHMARKS.md, "Cells split where their samples
+  // disagree").
   float reconstructSplit = 0.2f;
   // Luminance floor of lightcuts' relative error criterion (ShadingPoint::errorFloor): a
   // cut stops when its error bound is within error x max(estimate, floor), so pixels far
