@@ -43,6 +43,13 @@ RenderResult renderWith(const scene::Scene& s, const lightcuts::LightEvaluator& 
   return render(s, ev, o);
 }
 
+// A .ray box of size (sx, sy, sz), turned by rot about y, centred at (x, y, z).
+std::string box(float x, float y, float z, float sx, float sy, float sz, float rot, const char* mat) {
+  return "translate(" + std::to_string(x) + "," + std::to_string(y) + "," + std::to_string(z) + ", rotate(0,1,0," +
+         std::to_string(rot) + ", scale(" + std::to_string(sx) + "," + std::to_string(sy) + "," + std::to_string(sz) +
+         ", box { material = " + mat + "; })))\n";
+}
+
 // A room of the kind scripts/gen_random_room.py writes: partitions, boxes and a pillar
 // among 2,000 point lights, six tenths in clusters under the ceiling and the rest anywhere
 // (some close to surfaces, some inside boxes), so that many clusters are partly hidden
@@ -51,11 +58,6 @@ std::string randomRoom(uint32_t seed, int lights) {
   std::mt19937 rng(seed);
   auto u = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
   auto g = [&](float sd) { return std::normal_distribution<float>(0, sd)(rng); };
-  auto box = [](float x, float y, float z, float sx, float sy, float sz, float rot, const char* mat) {
-    return "translate(" + std::to_string(x) + "," + std::to_string(y) + "," + std::to_string(z) + ", rotate(0,1,0," +
-           std::to_string(rot) + ", scale(" + std::to_string(sx) + "," + std::to_string(sy) + "," + std::to_string(sz) +
-           ", box { material = " + mat + "; })))\n";
-  };
   const float W = 10, H = 4, D = 10;
   const char* wall = "{ diffuse = (0.7, 0.68, 0.65); }";
   std::string t = "SBT-raytracer 1.0\ncamera { position = (-4.2, 2.2, 4.5); look_at = (2, 1.2, -3); aspectratio = 1.5; fov = 60; }\n";
@@ -213,7 +215,6 @@ TEST(Accuracy, ReconstructionCutsWithinTwoPercentWithFarFewerShadowRays) {
   for (uint8_t d : coarse.done) ASSERT_EQ(d, 1);
 }
 
-
 // A floor seen from above under a row of thin slats, lit by lights scattered above them:
 // each light lays a slat's shadow, narrower than a pixel, somewhere else on the floor, so
 // the floor is striped with shadows that fall between samples four pixels apart. There
@@ -223,10 +224,8 @@ std::string slatFloor(uint32_t seed, int lights) {
   std::mt19937 rng(seed);
   auto u = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
   std::string t = "SBT-raytracer 1.0\ncamera { position = (0, 3, 0.01); look_at = (0, 0, 0); fov = 45; }\n";
-  t += "translate(0, -0.05, 0, scale(4, 0.1, 4, box { material = { diffuse = (0.6, 0.6, 0.6); }; }))\n";
-  for (int k = 0; k < 9; ++k)
-    t += "translate(" + std::to_string(-1.2f + 0.3f * float(k)) +
-         ", 0.25, 0, scale(0.03, 0.03, 3, box { material = { diffuse = (0.3, 0.3, 0.3); }; }))\n";
+  t += box(0, -0.05f, 0, 4, 0.1f, 4, 0, "{ diffuse = (0.6, 0.6, 0.6); }");
+  for (int k = 0; k < 9; ++k) t += box(-1.2f + 0.3f * float(k), 0.25f, 0, 0.03f, 0.03f, 3, 0, "{ diffuse = (0.3, 0.3, 0.3); }");
   for (int i = 0; i < lights; ++i)
     t += "point_light { position = (" + std::to_string(u(-2, 2)) + "," + std::to_string(u(0.8f, 1.6f)) + "," +
          std::to_string(u(-2, 2)) + "); colour = (" + std::to_string(2.0f / float(lights)) + "," +

@@ -219,24 +219,24 @@ void ReconstructionTile::run() {
     for (int cx = x0_; cx < x1_; cx += C) cellPixels(cx, cy, std::min(C, x1_ - cx), std::min(C, y1_ - cy));
 }
 
-// Whether a cell may be rebuilt whole: four corners on one surface, the nodes they disagree
-// about holding at most `limit` of their merged cut's light (the merged cut is made here and
-// kept for the cell's pixels: cell.ready[15] says whether the corners were on one surface).
-bool ReconstructionTile::cornersAgree(const CutSample* const* corners, int n, float limit) {
-  if (n != 4) return false;
+// How much of their light a cell's four corners disagree about (disagreementShare), or
+// nothing when they do not lie on one surface; their merged cut is made here and kept for
+// the cell's pixels.
+std::optional<float> ReconstructionTile::cornersDisagreement(const CutSample* const* corners, int n) {
+  if (n != 4) return std::nullopt;
   for (int i = 0; i < 4; ++i) {
-    if (!corners[i]->cut.valid) return false;
+    if (!corners[i]->cut.valid) return std::nullopt;
     for (int j = i + 1; j < 4; ++j)
       if (!sameSurface(corners[i]->shape, corners[i]->p, corners[i]->n, corners[j]->shape, corners[j]->p,
                        corners[j]->n))
-        return false;
+        return std::nullopt;
   }
   const lightcuts::CutRecord* cuts[4];
   for (int i = 0; i < 4; ++i) cuts[i] = &corners[i]->cut;
   lightcuts::MergedCut& merged = scratch_.cell.merged[15];
   r_.cuts.merge(cuts, 4, merged);
   scratch_.cell.ready[15] = true;
-  return r_.cuts.disagreement(merged, corners[0]->p, corners[0]->n) <= limit;
+  return r_.cuts.disagreement(merged, corners[0]->p, corners[0]->n);
 }
 
 // The surface a pixel centre's ray shades (false: none).
@@ -293,9 +293,11 @@ void ReconstructionTile::cellPixels(int cx, int cy, int w, int h) {
   // much of their light (RenderOptions::reconstructSplit).
   bool split = false;
   if (coarse) {
-    split = !cornersAgree(corners, n, kCoarseMaxDisagreement);
+    const std::optional<float> d = cornersDisagreement(corners, n);
+    split = !d || *d > kCoarseMaxDisagreement;
   } else if (o_.reconstructSplit < 1 && (w > 1 || h > 1)) {
-    split = !cornersAgree(corners, n, o_.reconstructSplit) && cell.ready[15];  // ready: on one surface
+    const std::optional<float> d = cornersDisagreement(corners, n);
+    split = d && *d > o_.reconstructSplit;
     n_.splitCells += split;
   }
   bool left = split;  // pixels this cell's samples cannot serve

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "lightcuts/evaluator.h"
@@ -225,7 +226,7 @@ class ReconstructionTile {
  private:
   size_t slot(int x, int y) const { return size_t(y - y0_) * size_t(x1_ - x0_ + 1) + size_t(x - x0_); }
   const CutSample& sample(int x, int y);
-  bool cornersAgree(const CutSample* const* corners, int n, float limit);
+  std::optional<float> cornersDisagreement(const CutSample* const* corners, int n);
   bool probe(int x, int y, int& shape, Vec3& p, Vec3& n) const;
   void cellPixels(int cx, int cy, int w, int h);
 

@@ -22,11 +22,17 @@ void quadricBoundsFunc(const RTCBoundsFunctionArguments* args) {
   b->upper_x = s->bounds.hi.x; b->upper_y = s->bounds.hi.y; b->upper_z = s->bounds.hi.z;
 }
 
-// The ray is transformed to the canonical frame; t is the same in both frames.
+// The ray is transformed to the canonical frame (origin o, direction d); t is the same in
+// both frames.
+bool hitQuadricLocal(const Shape& s, const RTCRay& r, float& t, int& part, Vec3& o, Vec3& d) {
+  o = s.toLocal.point(Vec3(r.org_x, r.org_y, r.org_z));
+  d = s.toLocal.vector(Vec3(r.dir_x, r.dir_y, r.dir_z));
+  return intersectQuadric(s, o, d, r.tnear, r.tfar, t, part);
+}
+
 bool hitQuadric(const Shape& s, const RTCRay& r, float& t, int& part, Vec3& worldNormal) {
-  Vec3 o = s.toLocal.point(Vec3(r.org_x, r.org_y, r.org_z));
-  Vec3 d = s.toLocal.vector(Vec3(r.dir_x, r.dir_y, r.dir_z));
-  if (!intersectQuadric(s, o, d, r.tnear, r.tfar, t, part)) return false;
+  Vec3 o, d;
+  if (!hitQuadricLocal(s, r, t, part, o, d)) return false;
   Vec3 pl = o + d * t;
   worldNormal = s.toLocal.normalFromInverse(quadricLocalNormal(s, pl, part));
   return true;
@@ -57,9 +63,8 @@ void quadricOccludedFunc(const RTCOccludedFunctionNArguments* args) {
   // normal were a third of the callback, perf on the warehouse of boxes).
   float t;
   int part;
-  const Vec3 o = s->toLocal.point(Vec3(r->org_x, r->org_y, r->org_z));
-  const Vec3 d = s->toLocal.vector(Vec3(r->dir_x, r->dir_y, r->dir_z));
-  if (intersectQuadric(*s, o, d, r->tnear, r->tfar, t, part)) r->tfar = -kInf;
+  Vec3 o, d;
+  if (hitQuadricLocal(*s, *r, t, part, o, d)) r->tfar = -kInf;
 }
 
 void embreeErrorFunc(void*, RTCError code, const char* str) {
