@@ -74,11 +74,18 @@ constexpr double kSmoothSpreadMin = 0.5;
 // visibility by one ray per cluster; they cancel on average and their net is what puts
 // pixels over 2% in rooms whose lights sit among occluders (measured per cut node on a
 // random room, scripts/gen_random_room.py: visible-representative clusters +2.35% of the
-// pixel, hidden-representative ones -2.50%; docs/LIGHTCUTS.md). A hidden representative's
-// spread is already its whole upper bound; a visible one's adds, in square, its estimate
-// squared times kHiddenSharePerBoundary times the point's boundary rate (how often refining
-// split a cluster into a visible and a hidden half: a share of partly hidden clusters).
-constexpr double kHiddenSharePerBoundary = 4.0;
+// pixel, hidden-representative ones -2.50%; docs/LIGHTCUTS.md). The ray samples a cluster
+// whose visible share is v as a coin of probability v: its error has a variance of v(1 - v)
+// times the cluster's unshadowed light squared. Two representatives disagree with
+// probability 2v(1 - v), so half the point's boundary rate (how often refining split a
+// cluster into a visible and a hidden half) stands for v(1 - v). A node whose sibling
+// agreed with it adds, in square, its unshadowed estimate squared times that, scaled so
+// that the criterion's 1.6 (kTotalFactor) root-sum-square holds 2.576 standard deviations,
+// where 99% of a normal error lies: (1.6 x 2.576)^2 / 2 = 8.5. (It was 4, chosen on random
+// rooms; a lattice, scripts/gen_pergola.py, whose clusters are all partly hidden, kept 1.8%
+// of pixels over 2% with full cuts. docs/LIGHTCUTS.md, "One coin for both sides".)
+constexpr double kVisibilityConfidence = 2.576;
+constexpr double kHiddenSharePerBoundary = kTotalFactor * kVisibilityConfidence * kTotalFactor * kVisibilityConfidence / 2;
 
 // Clusters of fewer lights are refined rather than probed: up to eight corner rays cost
 // more than refining a small cluster does.
@@ -96,11 +103,15 @@ constexpr uint32_t kClearMinLights = 16;
 constexpr uint32_t kClearGraceFailures = 48;
 constexpr uint32_t kClearFailuresPerSuccess = 8;
 
-// Directional clusters of at most this many lights that end in a cut without a first-order
-// estimate (an environment cluster across a surface's horizon, where the clamped cosine is
-// not smooth) are estimated by their exact unshadowed sum (a walk over their lights, no
-// rays) times one visibility: the representative's is a 0-or-everything sample there, the
-// error the white furnace showed at the default --error (docs/LIGHTCUTS.md).
+// Clusters of at most this many lights that end in a cut without a first-order estimate
+// and without a lower bound (across a surface's horizon, where the clamped cosine is not
+// smooth, or outside a spot's cone) are estimated by their exact unshadowed sum (a walk
+// over their lights, no rays) times one visibility. The representative alone is a
+// 0-or-everything sample there, and a tree's fixed representative errs the same way over
+// a whole surface: the white furnace's error for environment clusters at the default
+// --error; on a post's face beside lights above a lattice (accuracy_test's pergola) +2% of
+// the face's light from clusters whose representative is in front and -0.7% from those
+// whose representative is behind, 1.9% of the image's pixels over 2% (docs/LIGHTCUTS.md).
 constexpr uint32_t kExactSumMaxLights = 64;
 
 // What a representative's shadow ray found (recorded for reconstruction cuts) and, when
@@ -109,6 +120,7 @@ struct ShadowResult {
   CutVisibility found = CutVisibility::Untested;
   int blocker = Visibility::kVisible;
   float tHit = 0;
+  Color unshadowed;  // M * G per unit intensity, before the ray (kHiddenSharePerBoundary)
 };
 
 // M * G * V of one light per unit intensity (one shadow ray when the rest is non-zero).
@@ -121,6 +133,7 @@ inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoin
   float dist;
   res = ShadowResult{};
   if (!lightContribution(l, g, sp, mg, wi, dist)) return Color(0);
+  res.unshadowed = mg;
   if (clear) {
     res.found = CutVisibility::Visible;
     return mg;
@@ -178,7 +191,7 @@ class Lightcuts final : public LightEvaluator {
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
     bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
     bool clear;       // no surface can hide any of its lights (Visibility::boxClear)
-    float hideable;   // visible: its estimate's luminance squared, in sumHideable
+    float hideable;   // its (visible: estimate's, hidden coin: unshadowed) luminance squared, in sumHideable
     uint32_t blocker;  // the hint for its boxClear test
   };
 
@@ -269,8 +282,8 @@ class Lightcuts final : public LightEvaluator {
     Vec3d total;
     uint32_t cutSize = 0;
     // Sums of the squared spreads of the nodes in the heap: those scaled by the boundary
-    // rate, and the others; and of the squared estimates of those whose representative is
-    // visible (kHiddenSharePerBoundary).
+    // rate, and the others; and of the squared estimates (visible representative) or
+    // unshadowed estimates (hidden, as was its sibling's) that are coins (kHiddenSharePerBoundary).
     double sumSq = 0, sumScaled = 0, sumHideable = 0;
     uint32_t refinedTested = 0, refinedSplit = 0;  // the boundary rate's counts
     const bool rss = opt_.criterion == CutCriterion::Total;
@@ -330,7 +343,13 @@ class Lightcuts final : public LightEvaluator {
                                           : static_cast<const void*>(&tree.nodes[c]));
         if (freshCount < 2) fresh[freshCount++] = {t, left, right};
         const float lo = luminance(lower);
-        float spread = visible && !boundary ? std::max(0.0f, b - lo) : b;
+        // A hidden representative whose sibling's was hidden too is the other side of the
+        // same coin (kHiddenSharePerBoundary): its error is its cluster's visible part, and
+        // its variance is counted from its unshadowed estimate instead of its whole upper
+        // bound. Its upper bound still keys the heap: Walter's rule (every bound below
+        // error x estimate) holds as before.
+        const bool hiddenCoin = rss && !boundary && found == CutVisibility::Occluded;
+        float spread = visible && !boundary ? std::max(0.0f, b - lo) : hiddenCoin ? 0.0f : b;
         // Where the contribution is smooth over the cluster and its representative is
         // unoccluded, the node takes the first-order estimate (estimate.h) if it is still
         // in the cut at the end (most nodes are refined before that). Its spread, upper
@@ -343,7 +362,8 @@ class Lightcuts final : public LightEvaluator {
         const bool scaled = rss && fo && !boundary;
         (scaled ? sumScaled : sumSq) += double(spread) * spread;
         const float le = luminance(est);
-        const float hideable = rss && visible && !boundary && !clear ? le * le : 0.0f;
+        const float lu = hiddenCoin ? luminance(shadow.unshadowed * n.intensity) : le;
+        const float hideable = (hiddenCoin || (rss && visible && !boundary && !clear)) ? lu * lu : 0.0f;
         sumHideable += hideable;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
         nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, left, right, n.rep, n.lights(),
@@ -470,13 +490,12 @@ class Lightcuts final : public LightEvaluator {
       const CutNode& cn = nodes[uint32_t(key)];
       float factor = 1;
       const LightTree& ctree = forest_.trees[cn.tree];
-      if (firstOrder && !cn.firstOrder && cn.lower <= 0 && ctree.type == LightType::Directional &&
-          ctree.lightCount(cn.node) <= kExactSumMaxLights && cn.shadow.found != CutVisibility::Occluded &&
+      if (firstOrder && !cn.firstOrder && cn.lower <= 0 && ctree.lightCount(cn.node) <= kExactSumMaxLights && cn.shadow.found != CutVisibility::Occluded &&
           cn.shadow.found != CutVisibility::Partial) {
-        // A small environment cluster across the surface's horizon (no lower bound): its
-        // exact unshadowed sum, times the visibility of its representative or, when that one
-        // is behind the surface, of its brightest light.
-        Color exact = exactDirectionalSum(ctree, cn.node, sp, vis, stats, cn.shadow.found);
+        // A small cluster across the surface's horizon (no lower bound): its exact
+        // unshadowed sum, times the visibility of its representative or, when that one is
+        // behind the surface, of its brightest light.
+        Color exact = exactUnshadowedSum(ctree, cn.node, sp, vis, stats, cn.shadow.found);
         float raw = luminance(cn.estimate), le = luminance(exact);
         total += exact;
         total -= cn.estimate;
@@ -523,15 +542,15 @@ class Lightcuts final : public LightEvaluator {
   Method method() const override { return Method::Lightcuts; }
 
  private:
-  // The unshadowed sum of a directional cluster's lights at sp, times a visibility: 1 when
-  // its representative was found visible (`found`), else (the representative is behind the
-  // surface and cast no ray) that of its brightest light, one shadow ray.
-  Color exactDirectionalSum(const LightTree& tree, NodeRef node, const ShadingPoint& sp, Visibility& vis,
+  // The unshadowed sum of a cluster's lights at sp, times a visibility: 1 when its
+  // representative was found visible (`found`), else (the representative is behind the
+  // surface or outside its cone and cast no ray) that of its brightest light, one shadow ray.
+  Color exactUnshadowedSum(const LightTree& tree, NodeRef node, const ShadingPoint& sp, Visibility& vis,
                             EvalStats& stats, CutVisibility found) const {
     static thread_local std::vector<NodeRef> stack;
     stack.assign(1, node);
     Vec3d sum;
-    float brightest = 0;
+    float brightest = 0, brightestDist = kInf;
     Vec3 brightestDir;
     while (!stack.empty()) {
       const NodeRef r = stack.back();
@@ -551,12 +570,13 @@ class Lightcuts final : public LightEvaluator {
       if (luminance(c) > brightest) {
         brightest = luminance(c);
         brightestDir = wi;
+        brightestDist = dist;
       }
     }
     Color exact = sum.toFloat();
     if (found == CutVisibility::Visible || !(brightest > 0)) return exact;
     ++stats.shadowRays;
-    Color v = vis(brightestDir, kInf);
+    Color v = vis(brightestDir, brightestDist);
     stats.occludedRays += isBlack(v);
     return exact * v;
   }

@@ -113,6 +113,59 @@ TEST(Accuracy, LightcutsWithinTwoPercentInARoomOfPartlyHiddenClusters) {
   EXPECT_LE(m.fraction_over_threshold, 0.002) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
 }
 
+// A patio under a pergola, as scripts/gen_pergola.py writes it: a lattice of thin beams
+// and battens over a floor, two thirds of the lights high above it, the rest in four lamp
+// clusters under it. Every cluster above is partly hidden from every point below, in a
+// pattern that changes from light to light: one coin per cluster, tossed everywhere.
+std::string pergola(uint32_t seed, int lights) {
+  std::mt19937 rng(seed);
+  auto u = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
+  auto g = [&](float m, float sd) { return std::normal_distribution<float>(m, sd)(rng); };
+  const char* stone = "{ diffuse = (0.55, 0.5, 0.45); }";
+  const char* wood = "{ diffuse = (0.45, 0.3, 0.2); specular = (0.2, 0.2, 0.2); shininess = 20; }";
+  std::string t = "SBT-raytracer 1.0\ncamera { position = (-5.5, 2.4, 6.0); look_at = (1.0, 0.6, -1.0); fov = 60; }\n";
+  t += box(0, -0.05f, 0, 14, 0.1f, 14, 0, stone) + box(0, 1.5f, -7, 14, 3, 0.2f, 0, stone) + box(7, 1.5f, 0, 0.2f, 3, 14, 0, stone);
+  for (int i = -6; i <= 6; ++i) t += box(0.5f * float(i), 3, 0, 0.06f, 0.12f, 12, 0, wood);
+  for (int k = -5; k <= 5; ++k) t += box(0, 3.15f, 1.1f * float(k), 12, 0.08f, 0.05f, 0, wood);
+  for (float x : {-5.5f, 5.5f})
+    for (float z : {-5.5f, 0.0f, 5.5f}) t += box(x, 1.5f, z, 0.2f, 3, 0.2f, 0, wood);
+  for (int i = 0; i < 6; ++i) t += box(u(-4, 4), 0.4f, u(-4, 4), 1, 0.05f, 1, 0, wood);
+  const float lamps[4][2] = {{-3, -3}, {3, -3}, {-3, 3}, {3, 3}};
+  for (int i = 0; i < lights; ++i) {
+    float x, y, z, r = 1, gr = 0.95f, b = 0.8f, k = 60.0f / float(lights);
+    if (i % 3) {
+      x = u(-8, 8), y = u(5, 9), z = u(-8, 8);
+    } else {
+      x = g(lamps[i % 4][0], 0.2f), y = g(2.5f, 0.1f), z = g(lamps[i % 4][1], 0.2f);
+      gr = 0.7f, b = 0.4f, k *= 0.3f;
+    }
+    t += "point_light { position = (" + std::to_string(x) + "," + std::to_string(y) + "," + std::to_string(z) +
+         "); colour = (" + std::to_string(k * r) + "," + std::to_string(k * gr) + "," + std::to_string(k * b) + "); }\n";
+  }
+  return t;
+}
+
+// Under the lattice each cut node's error is its cluster's visible share sampled by one
+// ray, the coin the criterion counts from the boundary rate (kHiddenSharePerBoundary,
+// evaluator.cpp), and on the posts' faces beside the lights many clusters straddle the
+// face's horizon (kExactSumMaxLights). Measured on this patio with full cuts: 3.7% of
+// pixels over 2% with the earlier weight (4, hidden representatives counted by their
+// bounds), 1.9% with the coin counted for both sides at 2.576 standard deviations (a
+// post's face +1.9% too bright), 0.5% with the straddling clusters' exact sums as well.
+TEST(Accuracy, LightcutsWithinTwoPercentUnderALattice) {
+  auto s = scene::Scene::build(io::parseRayString(pergola(4242, 6000), "pergola.ray", "."));
+  auto brute = lightcuts::makeBruteForce(s->lights());
+  lightcuts::LightForest forest = lightcuts::buildLightForest(s->lights());
+  auto lc = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
+  RenderOptions o;
+  o.aa = AntiAliasing::Off;
+  o.width = o.height = 64;
+  RenderResult ref = render(*s, *brute, o);
+  RenderResult test = render(*s, *lc, o);
+  io::ImageMetrics m = io::compareImages(ref.image, test.image);
+  EXPECT_LE(m.fraction_over_threshold, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
+}
+
 // Clusters proven clear (Visibility::boxClear) are refined without rays. With a zero
 // threshold every cluster is refined down to its lights, so the image must be brute
 // force's: any cluster wrongly called clear would show there as light through a wall.
@@ -201,8 +254,9 @@ TEST(Accuracy, ReconstructionCutsWithinTwoPercentWithFarFewerShadowRays) {
   EXPECT_GT(rec.stats.reconstructionSamples, 0u);
   EXPECT_GT(rec.stats.eval.reconstructedPoints, rec.stats.eval.shadingPoints / 2);
   // Most points borrow visibility: fewer shadow rays than a lightcut at every point (in
-  // an image this small, edges, where points need their own cuts, are a large share).
-  EXPECT_LT(double(rec.stats.eval.shadowRays), 0.7 * double(full.stats.eval.shadowRays));
+  // an image this small, edges, where points need their own cuts, are a large share; the
+  // ratio is 0.70 here, and about a fifth at 512 x 512, docs/BENCHMARKS.md).
+  EXPECT_LT(double(rec.stats.eval.shadowRays), 0.75 * double(full.stats.eval.shadowRays));
   for (uint8_t d : rec.done) ASSERT_EQ(d, 1);
   EXPECT_EQ(rec.stats.reconstructionCoarseCells, 0u);
 
