@@ -310,6 +310,38 @@ TEST(Accuracy, CellsSplitWhereTheirSamplesDisagreeCatchShadowsBetweenThem) {
   for (uint8_t d : split.done) ASSERT_EQ(d, 1);
 }
 
+// A floor seen from above, crossed by a fence of upright boards standing on it, lit by
+// lights low on both sides: each board's two sides of the floor see different lights, so
+// an antialiasing sub-sample beside a board must not borrow from a sample across it
+// (RenderOptions::aaSeparationTest).
+TEST(Accuracy, SubSamplesCutOffFromTheirSamplesTakeFullCuts) {
+  std::mt19937 rng(11);
+  auto u = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
+  std::string t = "SBT-raytracer 1.0\ncamera { position = (0, 3, 0.01); look_at = (0, 0, 0); fov = 45; }\n";
+  t += box(0, -0.05f, 0, 4, 0.1f, 4, 0, "{ diffuse = (0.6, 0.6, 0.6); }");
+  for (int k = 0; k < 7; ++k) t += box(-0.9f + 0.3f * float(k), 0.2f, 0, 0.03f, 0.4f, 3, 0, "{ diffuse = (0.3, 0.3, 0.3); }");
+  for (int i = 0; i < 300; ++i)
+    t += "point_light { position = (" + std::to_string(u(-2, 2)) + "," + std::to_string(u(0.1f, 0.6f)) + "," +
+         std::to_string(u(-1.5f, 1.5f)) + "); colour = (0.01, 0.01, 0.01); }\n";
+  auto s = scene::Scene::build(io::parseRayString(t, "fence.ray", "."));
+  lightcuts::LightForest forest = lightcuts::buildLightForest(s->lights());
+  auto lc = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
+  RenderOptions o;
+  o.width = o.height = 256;
+  o.reconstructSpacing = 4;
+  o.referencePixels = 4096;
+  o.aaSeparationTest = false;
+  RenderResult off = render(*s, *lc, o);
+  o.aaSeparationTest = true;
+  RenderResult on = render(*s, *lc, o);
+  EXPECT_GT(on.stats.aaPixels, 0u);
+  EXPECT_GT(on.stats.reconstructionFallbacks, off.stats.reconstructionFallbacks);
+  // Measured: 3.27% -> 3.22% of reference pixels over 2% (the rest is the boards' faces,
+  // seen edge on, docs/LIGHTCUTS.md); on a pierced screen at 512 x 512, 0.98% -> 0.68%.
+  EXPECT_LE(on.stats.reference.fractionOver2pct, off.stats.reference.fractionOver2pct);
+  EXPECT_LT(on.stats.reference.meanRelativeError, off.stats.reference.meanRelativeError);
+}
+
 }  // namespace
 }  // namespace lc::render
 

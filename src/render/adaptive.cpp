@@ -282,9 +282,10 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
   auto shade = [&](Sub& b) {
     PrimaryHook hook;
     const CutSample* chosen[4];
-    if (rt) rt->subSampleHook(b.ray, x, y, b.u, hook, chosen, *cache);
-    Tracer tr{scene, ev, o.maxDepth, stats, rt ? &hook : nullptr};
     const uint64_t rays0 = stats.shadowRays;
+    if (rt) rt->subSampleHook(b.ray, x, y, b.u, hook, chosen, *cache);
+    stats.shadowRays += hook.separationRays;  // occlusion rays of the light's estimate
+    Tracer tr{scene, ev, o.maxDepth, stats, rt ? &hook : nullptr};
     if (!decouple) ++primary;
     Color c = tr.trace(b.ray, 0);
     if (!isFinite(c)) c = Color(0);

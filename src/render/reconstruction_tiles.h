@@ -84,6 +84,12 @@ constexpr float kSampleMaxFootprints = 3.0f;
 // samples (docs/LIGHTCUTS.md).
 constexpr float kCoarseMaxDisagreement = 0.05f;
 
+// How far, in scene epsilons, the segment between an antialiasing sub-sample and a sample
+// on its surface is lifted off the surface when tested for another surface cutting them off
+// (ReconstructionTile::subSampleHook): clear of the surface itself, below any surface that
+// touches it.
+constexpr float kSeparationLift = 8.0f;
+
 // The merged cuts of one cell of pixels, one per subset of its corner samples, made when
 // first needed.
 struct CellCuts {
@@ -120,6 +126,7 @@ struct PrimaryHook final : PrimaryLight {
   int cx[4] = {}, cy[4] = {};  // the samples' pixels
   bool preselected = false;  // samples chosen for this very hit (antialiasing): no hull test
   uint64_t fallbacks = 0;  // hits no sample could serve: they got a full lightcut
+  uint64_t separationRays = 0;  // antialiasing: rays that tested its samples for being cut off
 
   lightcuts::EvalResult light(const scene::Hit& h, const lightcuts::ShadingPoint& sp, lightcuts::Visibility& vis,
                               lightcuts::EvalStats& stats) override;
