@@ -2,6 +2,7 @@
 // instant radiosity), the acceptance criterion of the product at a size a test can afford.
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <random>
 #include <string>
 
@@ -48,6 +49,29 @@ std::string box(float x, float y, float z, float sx, float sy, float sz, float r
   return "translate(" + std::to_string(x) + "," + std::to_string(y) + "," + std::to_string(z) + ", rotate(0,1,0," +
          std::to_string(rot) + ", scale(" + std::to_string(sx) + "," + std::to_string(sy) + "," + std::to_string(sz) +
          ", box { material = " + mat + "; })))\n";
+}
+
+// A scene from .ray text, with brute force and lightcuts (default options) over its lights.
+struct Evaluated {
+  explicit Evaluated(const std::string& text)
+      : scene(scene::Scene::build(io::parseRayString(text, "test.ray", "."))),
+        brute(lightcuts::makeBruteForce(scene->lights())),
+        forest(lightcuts::buildLightForest(scene->lights())),
+        lc(lightcuts::makeLightcuts(scene->lights(), forest, lightcuts::CutOptions{})) {}
+  Evaluated(Evaluated&&) = delete;  // lc refers to forest
+  std::unique_ptr<scene::Scene> scene;
+  std::unique_ptr<lightcuts::LightEvaluator> brute;
+  lightcuts::LightForest forest;
+  std::unique_ptr<lightcuts::LightEvaluator> lc;
+};
+
+// Lightcuts' image (full cuts, no antialiasing) against brute force's.
+io::ImageMetrics fullCutsAgainstBrute(const Evaluated& e, int width, int height) {
+  RenderOptions o;
+  o.aa = AntiAliasing::Off;
+  o.width = width;
+  o.height = height;
+  return io::compareImages(render(*e.scene, *e.brute, o).image, render(*e.scene, *e.lc, o).image);
 }
 
 // A room of the kind scripts/gen_random_room.py writes: partitions, boxes and a pillar
@@ -98,18 +122,9 @@ std::string randomRoom(uint32_t seed, int lights) {
 // over 2%; with it none are. (The room is drawn with the standard library's
 // distributions, so another library may draw another room.)
 TEST(Accuracy, LightcutsWithinTwoPercentInARoomOfPartlyHiddenClusters) {
-  auto s = scene::Scene::build(io::parseRayString(randomRoom(777, 2000), "room.ray", "."));
-  ASSERT_EQ(s->lights().size(), 2000u);
-  auto brute = lightcuts::makeBruteForce(s->lights());
-  lightcuts::LightForest forest = lightcuts::buildLightForest(s->lights());
-  auto lc = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
-  RenderOptions o;
-  o.aa = AntiAliasing::Off;
-  o.width = 96;
-  o.height = 64;
-  RenderResult ref = render(*s, *brute, o);
-  RenderResult test = render(*s, *lc, o);
-  io::ImageMetrics m = io::compareImages(ref.image, test.image);
+  Evaluated e(randomRoom(777, 2000));
+  ASSERT_EQ(e.scene->lights().size(), 2000u);
+  io::ImageMetrics m = fullCutsAgainstBrute(e, 96, 64);
   EXPECT_LE(m.fraction_over_threshold, 0.002) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
 }
 
@@ -153,16 +168,7 @@ std::string pergola(uint32_t seed, int lights) {
 // bounds), 1.9% with the coin counted for both sides at 2.576 standard deviations (a
 // post's face +1.9% too bright), 0.5% with the straddling clusters' exact sums as well.
 TEST(Accuracy, LightcutsWithinTwoPercentUnderALattice) {
-  auto s = scene::Scene::build(io::parseRayString(pergola(4242, 6000), "pergola.ray", "."));
-  auto brute = lightcuts::makeBruteForce(s->lights());
-  lightcuts::LightForest forest = lightcuts::buildLightForest(s->lights());
-  auto lc = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
-  RenderOptions o;
-  o.aa = AntiAliasing::Off;
-  o.width = o.height = 64;
-  RenderResult ref = render(*s, *brute, o);
-  RenderResult test = render(*s, *lc, o);
-  io::ImageMetrics m = io::compareImages(ref.image, test.image);
+  io::ImageMetrics m = fullCutsAgainstBrute(Evaluated(pergola(4242, 6000)), 64, 64);
   EXPECT_LE(m.fraction_over_threshold, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
 }
 
@@ -288,10 +294,9 @@ std::string slatFloor(uint32_t seed, int lights) {
 }
 
 TEST(Accuracy, CellsSplitWhereTheirSamplesDisagreeCatchShadowsBetweenThem) {
-  auto s = scene::Scene::build(io::parseRayString(slatFloor(5, 400), "slats.ray", "."));
-  auto brute = lightcuts::makeBruteForce(s->lights());
-  lightcuts::LightForest forest = lightcuts::buildLightForest(s->lights());
-  auto lc = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
+  Evaluated e(slatFloor(5, 400));
+  const scene::Scene* s = e.scene.get();
+  const lightcuts::LightEvaluator *brute = e.brute.get(), *lc = e.lc.get();
   RenderOptions o;
   o.aa = AntiAliasing::Off;
   o.width = o.height = 64;
@@ -323,9 +328,9 @@ TEST(Accuracy, SubSamplesCutOffFromTheirSamplesTakeFullCuts) {
   for (int i = 0; i < 300; ++i)
     t += "point_light { position = (" + std::to_string(u(-2, 2)) + "," + std::to_string(u(0.1f, 0.6f)) + "," +
          std::to_string(u(-1.5f, 1.5f)) + "); colour = (0.01, 0.01, 0.01); }\n";
-  auto s = scene::Scene::build(io::parseRayString(t, "fence.ray", "."));
-  lightcuts::LightForest forest = lightcuts::buildLightForest(s->lights());
-  auto lc = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
+  Evaluated e(t);
+  const scene::Scene* s = e.scene.get();
+  const lightcuts::LightEvaluator* lc = e.lc.get();
   RenderOptions o;
   o.width = o.height = 256;
   o.reconstructSpacing = 4;
