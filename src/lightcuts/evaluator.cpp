@@ -85,7 +85,8 @@ constexpr double kSmoothSpreadMin = 0.5;
 // rooms; a lattice, scripts/gen_pergola.py, whose clusters are all partly hidden, kept 1.8%
 // of pixels over 2% with full cuts. docs/LIGHTCUTS.md, "One coin for both sides".)
 constexpr double kVisibilityConfidence = 2.576;
-constexpr double kHiddenSharePerBoundary = kTotalFactor * kVisibilityConfidence * kTotalFactor * kVisibilityConfidence / 2;
+constexpr double kHiddenSharePerBoundary =
+    kTotalFactor * kVisibilityConfidence * kTotalFactor * kVisibilityConfidence / 2;
 
 // Clusters of fewer lights are refined rather than probed: up to eight corner rays cost
 // more than refining a small cluster does.
@@ -191,7 +192,7 @@ class Lightcuts final : public LightEvaluator {
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
     bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
     bool clear;       // no surface can hide any of its lights (Visibility::boxClear)
-    float hideable;   // its (visible: estimate's, hidden coin: unshadowed) luminance squared, in sumHideable
+    float hideable;   // in sumHideable: its estimate's (hidden coin: unshadowed) luminance squared
     uint32_t blocker;  // the hint for its boxClear test
   };
 
@@ -283,7 +284,8 @@ class Lightcuts final : public LightEvaluator {
     uint32_t cutSize = 0;
     // Sums of the squared spreads of the nodes in the heap: those scaled by the boundary
     // rate, and the others; and of the squared estimates (visible representative) or
-    // unshadowed estimates (hidden, as was its sibling's) that are coins (kHiddenSharePerBoundary).
+    // unshadowed estimates (hidden, as was its sibling's) of the nodes that are coins
+    // (kHiddenSharePerBoundary).
     double sumSq = 0, sumScaled = 0, sumHideable = 0;
     uint32_t refinedTested = 0, refinedSplit = 0;  // the boundary rate's counts
     const bool rss = opt_.criterion == CutCriterion::Total;
@@ -490,11 +492,11 @@ class Lightcuts final : public LightEvaluator {
       const CutNode& cn = nodes[uint32_t(key)];
       float factor = 1;
       const LightTree& ctree = forest_.trees[cn.tree];
-      if (firstOrder && !cn.firstOrder && cn.lower <= 0 && ctree.lightCount(cn.node) <= kExactSumMaxLights && cn.shadow.found != CutVisibility::Occluded &&
-          cn.shadow.found != CutVisibility::Partial) {
+      if (firstOrder && !cn.firstOrder && cn.lower <= 0 && ctree.lightCount(cn.node) <= kExactSumMaxLights &&
+          cn.shadow.found != CutVisibility::Occluded && cn.shadow.found != CutVisibility::Partial) {
         // A small cluster across the surface's horizon (no lower bound): its exact
         // unshadowed sum, times the visibility of its representative or, when that one is
-        // behind the surface, of its brightest light.
+        // behind the surface or outside its cone, of its brightest light.
         Color exact = exactUnshadowedSum(ctree, cn.node, sp, vis, stats, cn.shadow.found);
         float raw = luminance(cn.estimate), le = luminance(exact);
         total += exact;
@@ -546,7 +548,7 @@ class Lightcuts final : public LightEvaluator {
   // representative was found visible (`found`), else (the representative is behind the
   // surface or outside its cone and cast no ray) that of its brightest light, one shadow ray.
   Color exactUnshadowedSum(const LightTree& tree, NodeRef node, const ShadingPoint& sp, Visibility& vis,
-                            EvalStats& stats, CutVisibility found) const {
+                           EvalStats& stats, CutVisibility found) const {
     static thread_local std::vector<NodeRef> stack;
     stack.assign(1, node);
     Vec3d sum;
