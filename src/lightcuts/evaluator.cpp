@@ -78,8 +78,8 @@ constexpr double kSmoothSpreadMin = 0.5;
 // whose visible share is v as a coin of probability v: its error has a variance of v(1 - v)
 // times the cluster's unshadowed light squared. Two representatives disagree with
 // probability 2v(1 - v), so half the point's boundary rate (how often refining split a
-// cluster into a visible and a hidden half) stands for v(1 - v). A node whose sibling
-// agreed with it adds, in square, its unshadowed estimate squared times that, scaled so
+// cluster into a visible and a hidden half) stands for v(1 - v). A visible node whose
+// sibling agreed with it adds, in square, its estimate squared times that, scaled so
 // that the criterion's 1.6 (kTotalFactor) root-sum-square holds 2.576 standard deviations,
 // where 99% of a normal error lies: (1.6 x 2.576)^2 / 2 = 8.5. (It was 4, chosen on random
 // rooms; a lattice, scripts/gen_pergola.py, whose clusters are all partly hidden, kept 1.8%
@@ -121,7 +121,6 @@ struct ShadowResult {
   CutVisibility found = CutVisibility::Untested;
   int blocker = Visibility::kVisible;
   float tHit = 0;
-  Color unshadowed;  // M * G per unit intensity, before the ray (kHiddenSharePerBoundary)
 };
 
 // M * G * V of one light per unit intensity (one shadow ray when the rest is non-zero).
@@ -134,7 +133,6 @@ inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoin
   float dist;
   res = ShadowResult{};
   if (!lightContribution(l, g, sp, mg, wi, dist)) return Color(0);
-  res.unshadowed = mg;
   if (clear) {
     res.found = CutVisibility::Visible;
     return mg;
@@ -192,7 +190,7 @@ class Lightcuts final : public LightEvaluator {
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
     bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
     bool clear;       // no surface can hide any of its lights (Visibility::boxClear)
-    float hideable;   // in sumHideable: its estimate's (hidden coin: unshadowed) luminance squared
+    float hideable;   // visible: its estimate's luminance squared, in sumHideable
     uint32_t blocker;  // the hint for its boxClear test
   };
 
@@ -283,9 +281,8 @@ class Lightcuts final : public LightEvaluator {
     Vec3d total;
     uint32_t cutSize = 0;
     // Sums of the squared spreads of the nodes in the heap: those scaled by the boundary
-    // rate, and the others; and of the squared estimates (visible representative) or
-    // unshadowed estimates (hidden, as was its sibling's) of the nodes that are coins
-    // (kHiddenSharePerBoundary).
+    // rate, and the others; and of the squared estimates of those whose representative is
+    // visible (kHiddenSharePerBoundary).
     double sumSq = 0, sumScaled = 0, sumHideable = 0;
     uint32_t refinedTested = 0, refinedSplit = 0;  // the boundary rate's counts
     const bool rss = opt_.criterion == CutCriterion::Total;
@@ -345,13 +342,11 @@ class Lightcuts final : public LightEvaluator {
                                           : static_cast<const void*>(&tree.nodes[c]));
         if (freshCount < 2) fresh[freshCount++] = {t, left, right};
         const float lo = luminance(lower);
-        // A hidden representative whose sibling's was hidden too is the other side of the
-        // same coin (kHiddenSharePerBoundary): its error is its cluster's visible part, and
-        // its variance is counted from its unshadowed estimate instead of its whole upper
-        // bound. Its upper bound still keys the heap: Walter's rule (every bound below
-        // error x estimate) holds as before.
-        const bool hiddenCoin = rss && !boundary && found == CutVisibility::Occluded;
-        float spread = visible && !boundary ? std::max(0.0f, b - lo) : hiddenCoin ? 0.0f : b;
+        // A hidden representative's spread stays its whole upper bound. (Counting its
+        // cluster's visible part as the other side of the visibility coin instead, from its
+        // unshadowed estimate, saved 7-11% of the rays but put a room lit through blinds,
+        // scripts/gen_blinds.py, from 1.44% to 1.68% of pixels over 2%: docs/LIGHTCUTS.md.)
+        float spread = visible && !boundary ? std::max(0.0f, b - lo) : b;
         // Where the contribution is smooth over the cluster and its representative is
         // unoccluded, the node takes the first-order estimate (estimate.h) if it is still
         // in the cut at the end (most nodes are refined before that). Its spread, upper
@@ -364,8 +359,7 @@ class Lightcuts final : public LightEvaluator {
         const bool scaled = rss && fo && !boundary;
         (scaled ? sumScaled : sumSq) += double(spread) * spread;
         const float le = luminance(est);
-        const float lu = hiddenCoin ? luminance(shadow.unshadowed * n.intensity) : le;
-        const float hideable = (hiddenCoin || (rss && visible && !boundary && !clear)) ? lu * lu : 0.0f;
+        const float hideable = rss && visible && !boundary && !clear ? le * le : 0.0f;
         sumHideable += hideable;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
         nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, left, right, n.rep, n.lights(),

@@ -58,11 +58,9 @@ inline const char* methodName(Method m) { return enumName(kMethodNames, m); }
 //     lower bound (what the estimate of an unoccluded cluster can be off by), for a
 //     first-order estimate scaled down where the point sees few shadow boundaries; a
 //     node with a visible representative also counts the part of its cluster that may be
-//     hidden, and one whose representative and sibling's were hidden the part that may be
-//     visible instead of its upper bound, in proportion to how often the point's clusters
-//     turned out partly hidden (evaluator.cpp, kHiddenSharePerBoundary). The errors of a
-//     cut have random signs, so this keeps the total error, not just each node's, near
-//     errorRatio.
+//     hidden, in proportion to how often the point's clusters turned out partly hidden
+//     (evaluator.cpp, kHiddenSharePerBoundary). The errors of a cut have random signs, so
+//     this keeps the total error, not just each node's, near errorRatio.
 enum class CutCriterion { Walter, Total };
 inline constexpr EnumName<CutCriterion> kCutCriterionNames[] = {
     {CutCriterion::Total, "total",

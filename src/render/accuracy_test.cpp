@@ -164,9 +164,9 @@ std::string pergola(uint32_t seed, int lights) {
 // ray, the coin the criterion counts from the boundary rate (kHiddenSharePerBoundary,
 // evaluator.cpp), and on the posts' faces beside the lights many clusters straddle the
 // face's horizon (kExactSumMaxLights). Measured on this patio with full cuts: 3.7% of
-// pixels over 2% with the earlier weight (4, hidden representatives counted by their
-// bounds), 1.9% with the coin counted for both sides at 2.576 standard deviations (a
-// post's face +1.9% too bright), 0.5% with the straddling clusters' exact sums as well.
+// pixels over 2% with the earlier weight (4), 1.9% with the coin weighed at 2.576 standard
+// deviations (a post's face +1.9% too bright), 0.5% with the straddling clusters' exact
+// sums as well.
 TEST(Accuracy, LightcutsWithinTwoPercentUnderALattice) {
   io::ImageMetrics m = fullCutsAgainstBrute(Evaluated(pergola(4242, 6000)), 64, 64);
   EXPECT_LE(m.fraction_over_threshold, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
