@@ -7,8 +7,12 @@ review of the coin and separation changes.
 
   /usr/bin/python3 scripts/gen_blinds.py SEED N OUT.ray
 """
+import os
 import random
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gen_scenes import box  # noqa: E402
 
 
 def main(argv):
@@ -23,33 +27,28 @@ def main(argv):
          "material = { name = slat; diffuse = (0.85, 0.85, 0.82); }",
          "material = { name = wood; diffuse = (0.5, 0.35, 0.2); }"]
 
-    def box(c, s, mat, rx=0.0, ry=0.0):
-        o.append("translate(%g,%g,%g, rotate(0,1,0,%g, rotate(1,0,0,%g, scale(%g,%g,%g, box { material = %s; }))))"
-                 % (c[0], c[1], c[2], ry, rx, s[0], s[1], s[2], mat))
-
     W, H, D = 6.0, 2.8, 6.0
-    box((0, -0.05, 0), (W, 0.1, D), "floor")
-    box((0, H + 0.05, 0), (W, 0.1, D), "wall")
-    box((W / 2 + 0.05, H / 2, 0), (0.1, H, D), "wall")
-    box((0, H / 2, D / 2 + 0.05), (W, H, 0.1), "wall")
-    box((0, H / 2, -D / 2 - 0.05), (W, H, 0.1), "wall")
+    o.append(box((0, -0.05, 0), (W, 0.1, D), "floor").rstrip())
+    o.append(box((0, H + 0.05, 0), (W, 0.1, D), "wall").rstrip())
+    o.append(box((W / 2 + 0.05, H / 2, 0), (0.1, H, D), "wall").rstrip())
+    o.append(box((0, H / 2, D / 2 + 0.05), (W, H, 0.1), "wall").rstrip())
+    o.append(box((0, H / 2, -D / 2 - 0.05), (W, H, 0.1), "wall").rstrip())
     # The window wall at x = -3, an opening from y 0.8 to 2.4, z -1.5 to 1.5.
-    box((-W / 2 - 0.05, 0.4, 0), (0.1, 0.8, D), "wall")
-    box((-W / 2 - 0.05, 2.6, 0), (0.1, 0.4, D), "wall")
-    box((-W / 2 - 0.05, 1.6, -2.25), (0.1, 1.6, 1.5), "wall")
-    box((-W / 2 - 0.05, 1.6, 2.25), (0.1, 1.6, 1.5), "wall")
+    o.append(box((-W / 2 - 0.05, 0.4, 0), (0.1, 0.8, D), "wall").rstrip())
+    o.append(box((-W / 2 - 0.05, 2.6, 0), (0.1, 0.4, D), "wall").rstrip())
+    o.append(box((-W / 2 - 0.05, 1.6, -2.25), (0.1, 1.6, 1.5), "wall").rstrip())
+    o.append(box((-W / 2 - 0.05, 1.6, 2.25), (0.1, 1.6, 1.5), "wall").rstrip())
     y = 0.84
     while y < 2.4:                                           # slats tilted 30 degrees
-        box((-W / 2 + 0.08, y, 0), (0.05, 0.004, 3.0), "slat", rx=0, ry=0)
-        o[-1] = o[-1].replace("rotate(1,0,0,0,", "rotate(0,0,1,-30,")
+        o.append(box((-W / 2 + 0.08, y, 0), (0.05, 0.004, 3.0), "slat", rot_z=-30).rstrip())
         y += 0.04
-    box((-1.6, 0.74, -0.4), (0.8, 0.04, 1.6), "wood")      # desk top
+    o.append(box((-1.6, 0.74, -0.4), (0.8, 0.04, 1.6), "wood").rstrip())  # desk top
     for dx in (-0.35, 0.35):
         for dz in (-0.75, 0.75):
-            box((-1.6 + dx, 0.36, -0.4 + dz), (0.04, 0.72, 0.04), "wood")
-    box((1.0, 0.9, -2.8), (1.6, 1.8, 0.35), "wood")         # shelf
-    box((-0.8, 0.45, 0.6), (0.45, 0.05, 0.45), "wood", ry=20)  # chair seat
-    box((-0.8, 0.85, 0.82), (0.45, 0.8, 0.04), "wood", ry=20)   # chair back
+            o.append(box((-1.6 + dx, 0.36, -0.4 + dz), (0.04, 0.72, 0.04), "wood").rstrip())
+    o.append(box((1.0, 0.9, -2.8), (1.6, 1.8, 0.35), "wood").rstrip())  # shelf
+    o.append(box((-0.8, 0.45, 0.6), (0.45, 0.05, 0.45), "wood", rot_y=20).rstrip())  # chair seat
+    o.append(box((-0.8, 0.85, 0.82), (0.45, 0.8, 0.04), "wood", rot_y=20).rstrip())  # chair back
     lamps = [(-1.9, 0.95, -0.9), (1.6, 1.9, -2.7)]
     for i in range(n):
         if i % 4 == 0:

@@ -160,9 +160,11 @@ class Mesh:
         return "".join(out)
 
 
-def box(center, size, mat, rot_y=0.0):
-    """An axis-aligned (or rotated about y) box quadric."""
+def box(center, size, mat, rot_y=0.0, rot_z=0.0):
+    """An axis-aligned box quadric, or one rotated about z, then about y (degrees)."""
     s = f"scale({num(size[0])}, {num(size[1])}, {num(size[2])}, box {{ material = {mat}; }})"
+    if rot_z:
+        s = f"rotate(0, 0, 1, {num(rot_z)}, {s})"
     if rot_y:
         s = f"rotate(0, 1, 0, {num(rot_y)}, {s})"
     return f"translate({num(center[0])}, {num(center[1])}, {num(center[2])}, {s})\n"

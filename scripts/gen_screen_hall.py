@@ -8,8 +8,12 @@ a quarter scattered anywhere. Written after the visibility coin's weight was der
 
   /usr/bin/python3 scripts/gen_screen_hall.py SEED N OUT.ray
 """
+import os
 import random
 import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gen_scenes import box  # noqa: E402
 
 
 def main(argv):
@@ -24,33 +28,29 @@ def main(argv):
          "material = { name = screen; diffuse = (0.55, 0.4, 0.28); }",
          "material = { name = stone; diffuse = (0.6, 0.6, 0.58); }"]
 
-    def box(c, s, mat, rot=0.0):
-        o.append("translate(%g,%g,%g, rotate(0,1,0,%g, scale(%g,%g,%g, box { material = %s; })))"
-                 % (c[0], c[1], c[2], rot, s[0], s[1], s[2], mat))
-
     W, H, D = 12.0, 4.0, 14.0
-    box((0, -0.05, 0), (W, 0.1, D), "floor")
-    box((0, H + 0.05, 0), (W, 0.1, D), "plaster")
-    box((-W / 2 - 0.05, H / 2, 0), (0.1, H, D), "plaster")
-    box((W / 2 + 0.05, H / 2, 0), (0.1, H, D), "plaster")
-    box((0, H / 2, -D / 2 - 0.05), (W, H, 0.1), "plaster")
-    box((0, H / 2, D / 2 + 0.05), (W, H, 0.1), "plaster")
+    o.append(box((0, -0.05, 0), (W, 0.1, D), "floor").rstrip())
+    o.append(box((0, H + 0.05, 0), (W, 0.1, D), "plaster").rstrip())
+    o.append(box((-W / 2 - 0.05, H / 2, 0), (0.1, H, D), "plaster").rstrip())
+    o.append(box((W / 2 + 0.05, H / 2, 0), (0.1, H, D), "plaster").rstrip())
+    o.append(box((0, H / 2, -D / 2 - 0.05), (W, H, 0.1), "plaster").rstrip())
+    o.append(box((0, H / 2, D / 2 + 0.05), (W, H, 0.1), "plaster").rstrip())
     # The screen at z = 0: vertical and horizontal bars 0.08 thick, openings 0.22 wide.
     pitch, bar = 0.3, 0.08
     x = -W / 2
     while x <= W / 2 + 1e-6:
-        box((x, 1.9, 0), (bar, 3.0, 0.12), "screen")
+        o.append(box((x, 1.9, 0), (bar, 3.0, 0.12), "screen").rstrip())
         x += pitch
     y = 0.4
     while y <= 3.4 + 1e-6:
-        box((0, y, 0), (W, bar, 0.12), "screen")
+        o.append(box((0, y, 0), (W, bar, 0.12), "screen").rstrip())
         y += pitch
-    box((0, 0.2, 0), (W, 0.4, 0.12), "stone")        # plinth under the screen
-    box((0, 3.7, 0), (W, 0.6, 0.12), "stone")        # lintel above it
+    o.append(box((0, 0.2, 0), (W, 0.4, 0.12), "stone").rstrip())  # plinth under the screen
+    o.append(box((0, 3.7, 0), (W, 0.6, 0.12), "stone").rstrip())  # lintel above it
     for px in (-3.0, 0.5, 4.0):                      # pillars in the near half
-        box((px, H / 2, 3.0 + rng.uniform(-0.5, 0.5)), (0.35, H, 0.35), "stone", rng.uniform(0, 45))
+        o.append(box((px, H / 2, 3.0 + rng.uniform(-0.5, 0.5)), (0.35, H, 0.35), "stone", rng.uniform(0, 45)).rstrip())
     for _ in range(4):                               # benches
-        box((rng.uniform(-5, 5), 0.25, rng.uniform(1.5, 6)), (1.6, 0.1, 0.45), "screen", rng.uniform(-30, 30))
+        o.append(box((rng.uniform(-5, 5), 0.25, rng.uniform(1.5, 6)), (1.6, 0.1, 0.45), "screen", rng.uniform(-30, 30)).rstrip())
     lights = []
     far_lamps = [(rng.uniform(-5, 5), rng.uniform(1.0, 3.6), rng.uniform(-6.5, -1.0)) for _ in range(8)]
     near_lamps = [(rng.uniform(-5, 5), rng.uniform(2.8, 3.8), rng.uniform(1.0, 6.5)) for _ in range(4)]
