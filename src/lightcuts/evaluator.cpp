@@ -429,17 +429,6 @@ class Lightcuts final : public LightEvaluator {
         stats.clearedClusters += cnClear;
         (cnClear ? clearSuccesses : clearFailures) += 1;
       }
-      if (!record && cn.lights <= kExactClusterLights && cutSize + cn.lights <= maxCut) {
-        const bool split = addLights(tree, cn.node, cn.rep, cn.unit, cn.shadow, cnClear, sp, vis, stats, total);
-        cutSize += cn.lights;
-        // Counted in the boundary rate as one refinement: split if a light's visibility
-        // differs from the representative's.
-        if (cn.shadow.found != CutVisibility::Untested) {
-          ++refinedTested;
-          refinedSplit += split;
-        }
-        continue;
-      }
       ShadowResult shadows[2];
       Color units[2];
       bool boundary = false;
@@ -549,41 +538,6 @@ class Lightcuts final : public LightEvaluator {
   Method method() const override { return Method::Lightcuts; }
 
  private:
-  // Adds the lights of the cluster at `node` (at most kExactClusterLights) to `total`, each
-  // with its own shadow ray (none in a clear cluster; the representative's is `repShadow`,
-  // its M * G * V `repUnit`). Whether a light's visibility differs from the representative's.
-  bool addLights(const LightTree& tree, NodeRef node, uint32_t rep, const Color& repUnit,
-                 const ShadowResult& repShadow, bool clear, const ShadingPoint& sp, Visibility& vis,
-                 EvalStats& stats, Vec3d& total) const {
-    uint32_t leaves[kExactClusterLights];
-    NodeRef stack[kExactClusterLights];
-    uint32_t count = 0, depth = 0;
-    stack[depth++] = node;
-    while (depth > 0) {
-      const NodeRef r = stack[--depth];
-      if (isLeafRef(r)) {
-        leaves[count++] = leafLight(r);
-        __builtin_prefetch(&lights_.lights[leafLight(r)]);
-        continue;
-      }
-      const LightNode& n = tree.nodes[r];
-      stack[depth++] = n.right(r);
-      stack[depth++] = n.left(r);
-    }
-    auto hidden = [](CutVisibility v) { return v == CutVisibility::Occluded || v == CutVisibility::Partial; };
-    bool split = false;
-    for (uint32_t i = 0; i < count; ++i) {
-      const Light& l = lights_.lights[leaves[i]];
-      ShadowResult s = repShadow;
-      const Color unit =
-          leaves[i] == rep ? repUnit : shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, s, false, clear);
-      total += unit * leafIntensity(l);
-      split |= s.found != CutVisibility::Untested && repShadow.found != CutVisibility::Untested &&
-               hidden(s.found) != hidden(repShadow.found);
-    }
-    return split;
-  }
-
   // The unshadowed sum of a cluster's lights at sp, times a visibility: 1 when its
   // representative was found visible (`found`), else (the representative is behind the
   // surface or outside its cone and cast no ray) that of its brightest light, one shadow ray.

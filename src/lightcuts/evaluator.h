@@ -78,18 +78,6 @@ inline const char* cutCriterionName(CutCriterion c) { return enumName(kCutCriter
 // lights per pixel).
 constexpr float kCourseCutsDefaultError = 0.25f;
 
-// A cluster of at most this many lights that is about to be refined is summed light by
-// light instead, each light exact with its own ray, no bounds and no heap (unless the cut
-// is recorded: a recorded cut is what reconstructed points evaluate, and its size is paid
-// by each of them). Refining a cluster of k lights to its leaves takes k - 1 refinements of
-// about four rays' cost each (issue 21: a cut node costs ~4 shadow rays) plus their rays;
-// the sum takes the k - 1 rays alone. Where the cut would have stopped at the children it
-// spends k - 2 rays for one refinement: even at 8. Measured (docs/BENCHMARKS.md): the
-// church at 160 x 160, full cuts, 96-102 s -> 60-64 s (+18% rays); a random room
-// (scripts/gen_random_room.py) -15%; the 100k-light room, whose cuts hold larger clusters,
-// unchanged.
-inline constexpr uint32_t kExactClusterLights = 8;
-
 struct CutOptions {
   float errorRatio = 0.02f;  // --error: relative error threshold
   int maxCut = 4000;         // --max-cut: most nodes in one cut, plus one per tree after the first

@@ -184,22 +184,6 @@ TEST(Lightcuts, RefinesTheLargestBoundFirst) {
       NodeRef ni = heap.top().second;
       heap.pop();
       --size;
-      // A small cluster is summed light by light (kExactClusterLights).
-      if (uint32_t k = t.lightCount(ni); k <= kExactClusterLights && size + k <= maxCut) {
-        std::vector<NodeRef> stack{ni};
-        while (!stack.empty()) {
-          NodeRef r = stack.back();
-          stack.pop_back();
-          if (isLeafRef(r)) {
-            expect += unit(r) * t.node(s, r).intensity;
-            ++size;
-          } else {
-            stack.push_back(t.nodes[r].left(r));
-            stack.push_back(t.nodes[r].right(r));
-          }
-        }
-        continue;
-      }
       add(t.nodes[ni].left(ni));
       add(t.nodes[ni].right(ni));
     }
