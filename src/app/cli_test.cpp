@@ -486,7 +486,7 @@ TEST(CliUsage, RenderHelpIsGroupedAndStatesEveryDefault) {
     EXPECT_NE(entry.find("default"), std::string::npos) << "no default stated: " << entry;
   }
   // A few values, as the code defines them.
-  EXPECT_NE(h.find("Most nodes in one cut; default 4000"), std::string::npos) << h;
+  EXPECT_NE(h.find("Most nodes in one cut; default 16000"), std::string::npos) << h;
   EXPECT_NE(h.find("default 512, or from --height"), std::string::npos) << h;
   EXPECT_NE(h.find("Limit on VPLs; default 10000000"), std::string::npos) << h;
   EXPECT_NE(h.find("default auto: 4 for images of 512 x 512 pixels or more"), std::string::npos) << h;
@@ -1084,6 +1084,29 @@ TEST(CliWarnings, NoLights) {
                               "show (add a point_light, directional_light, spot_light or area_light, or a luminosity "
                               "to a material)"});
   EXPECT_TRUE(fs::exists(dir.file("out.png")));
+}
+
+// Cuts out of --max-cut nodes before their bound holds: the pixels may be off by more
+// than --error, and the render says so (with the share); with the default budget, not.
+TEST(CliWarnings, CutsStoppedByMaxCut) {
+  TempDir dir;
+  std::string lights;
+  for (int i = 0; i < 40; ++i)
+    lights += "point_light { position = (" + std::to_string(i % 8 - 4) + ", 3, " + std::to_string(i / 8 - 2) +
+              "); colour = (0.1,0.1,0.1); }\n";
+  writeText(dir.file("s.ray"), kHeader + kLitFloor + lights);
+  CliResult r = run({"render", "s.ray", "-o", "out.png", "--width", "24", "-q", "--max-cut", "2"}, dir.path());
+  EXPECT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> n = notes(r.err);
+  ASSERT_EQ(n.size(), 1u) << r.err;
+  EXPECT_EQ(n[0].rfind("lightcuts: warning: ", 0), 0u) << n[0];
+  EXPECT_NE(n[0].find("% of the cuts stopped at --max-cut 2 before their error bound held: those pixels may be "
+                      "further from brute force than --error (raise --max-cut)"),
+            std::string::npos)
+      << n[0];
+  EXPECT_TRUE(fs::exists(dir.file("out.png")));
+  r = run({"render", "s.ray", "-o", "out.png", "--width", "24", "-q"}, dir.path());
+  EXPECT_EQ(r.err, "");
 }
 
 TEST(CliWarnings, BlackImageSaysWhy) {

@@ -474,6 +474,8 @@ void reportRender(const RenderArgs& a, Cluster* cluster, const RenderSetup& s, c
     facts.cameraHitFraction = cameraHitFraction(scene);
     std::string w = blackImageWarning(rr.image, s.ext == "exr" ? io::ToneMap::Srgb : a.tonemap, a.exposure, facts);
     if (!w.empty()) printWarning(w);
+    w = maxCutWarning(es.cutsAtMaxCut, es.shadingPoints, a.maxCut);
+    if (!w.empty()) printWarning(w);
   }
   if (!a.cutHeatmap.empty()) {
     float maxCut = 1;

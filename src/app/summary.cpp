@@ -54,6 +54,7 @@ void forEachEvalCounter(S& s, F&& f) {
   f("hidden_clusters", s.hiddenClusters);
   f("clear_tests", s.clearTests);
   f("cleared_clusters", s.clearedClusters);
+  f("cuts_at_max_cut", s.cutsAtMaxCut);
   f("group_probes", s.groupProbes);
   f("failed_group_probes", s.failedGroupProbes);
   f("traced_rays", s.tracedRays);
@@ -177,6 +178,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["clear_clusters"] = switchName(a.clearClusters);
   j["clear_tests"] = es.clearTests;
   j["cleared_clusters"] = es.clearedClusters;
+  j["cuts_at_max_cut"] = es.cutsAtMaxCut;
   j["group_probes"] = es.groupProbes;
   j["failed_group_probes"] = es.failedGroupProbes;
   j["reconstruct_spacing"] = ro.reconstructSpacing;

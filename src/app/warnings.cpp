@@ -21,6 +21,14 @@ double blackFraction(const io::Image& image, io::ToneMap tonemap, float exposure
   return double(black) / double(image.pixels.size());
 }
 
+std::string maxCutWarning(uint64_t cutsAtMaxCut, uint64_t shadingPoints, int maxCut) {
+  if (shadingPoints == 0 || !(double(cutsAtMaxCut) > kMaxCutShare * double(shadingPoints))) return {};
+  return fmt::format(
+      "{:.1f}% of the cuts stopped at --max-cut {} before their error bound held: those pixels may be further "
+      "from brute force than --error (raise --max-cut)",
+      100.0 * double(cutsAtMaxCut) / double(shadingPoints), maxCut);
+}
+
 std::string blackImageWarning(const io::Image& image, io::ToneMap tonemap, float exposure, const RenderFacts& f) {
   double fraction = blackFraction(image, tonemap, exposure);
   if (fraction < kMostlyBlack) return "";

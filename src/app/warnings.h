@@ -35,6 +35,12 @@ double blackFraction(const io::Image& image, io::ToneMap tonemap, float exposure
 constexpr double kMostlyBlack = 0.98;
 std::string blackImageWarning(const io::Image& image, io::ToneMap tonemap, float exposure, const RenderFacts& facts);
 
+// The warning for cuts that ran out of --max-cut nodes before their error bound held
+// (EvalStats::cutsAtMaxCut): over kMaxCutShare of the shading points, their pixels may be
+// further from brute force than --error. Empty otherwise.
+constexpr double kMaxCutShare = 0.001;
+std::string maxCutWarning(uint64_t cutsAtMaxCut, uint64_t shadingPoints, int maxCut);
+
 // The hint for an error message: --lenient for unknown keywords; empty for other errors.
 std::string hintForError(const std::string& bareMessage);
 

@@ -53,6 +53,15 @@ TEST(BlackImage, ReasonFollowsTheFacts) {
   EXPECT_EQ(blackImageWarning(most, io::ToneMap::Srgb, 0, f), "");
 }
 
+TEST(MaxCut, WarnsOverATenthOfAPercentOfTheCuts) {
+  EXPECT_EQ(maxCutWarning(0, 1000, 4000), "");
+  EXPECT_EQ(maxCutWarning(1, 1000, 4000), "");  // 0.1%: not over
+  EXPECT_EQ(maxCutWarning(5, 0, 4000), "");
+  const std::string w = maxCutWarning(25, 1000, 4000);
+  EXPECT_NE(w.find("2.5% of the cuts stopped at --max-cut 4000"), std::string::npos) << w;
+  EXPECT_NE(w.find("raise --max-cut"), std::string::npos) << w;
+}
+
 TEST(ErrorHints, LenientForUnknownKeywordsOnly) {
   EXPECT_NE(hintForError("unknown keyword 'radius' in sphere").find("--lenient"), std::string::npos);
   EXPECT_EQ(hintForError("expected '=', got '('"), "");

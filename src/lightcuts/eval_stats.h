@@ -24,6 +24,7 @@ struct EvalStats {
   uint64_t hiddenClusters = 0;       // clusters kept in a cut as hidden by their probes
   uint64_t clearTests = 0;           // clusters tested for being visible as a whole (boxClear)
   uint64_t clearedClusters = 0;      // those found so
+  uint64_t cutsAtMaxCut = 0;         // cuts stopped by --max-cut before their error bound held
   uint64_t groupProbes = 0;          // rays testing groups of borrowed nodes (reconstruction.h)
   // Those that found the samples wrong: a group hidden where every sample saw it, or
   // visible where every sample found it occluded (MergedCut::hidden).
@@ -64,6 +65,7 @@ struct EvalStats {
     hiddenClusters += o.hiddenClusters;
     clearTests += o.clearTests;
     clearedClusters += o.clearedClusters;
+    cutsAtMaxCut += o.cutsAtMaxCut;
     groupProbes += o.groupProbes;
     failedGroupProbes += o.failedGroupProbes;
     tracedRays += o.tracedRays;

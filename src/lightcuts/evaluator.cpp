@@ -387,7 +387,6 @@ class Lightcuts final : public LightEvaluator {
     const float eps = opt_.errorRatio;
     const double rssFactor2 = kTotalFactor * kTotalFactor;
     while (!heap.empty()) {
-      if (cutSize >= maxCut) break;
       // Weber's law has a floor: below errorFloor (set by the renderer from the image's
       // mean) the cut is held to an absolute error, as the image metric's floor does.
       float limit = float(eps * std::max(luminance(total), double(sp.errorFloor)));
@@ -399,6 +398,12 @@ class Lightcuts final : public LightEvaluator {
         if (sumSq + w * w * sumScaled + kHiddenSharePerBoundary * rate * sumHideable <=
             rssFactor2 * double(limit) * limit)
           break;
+      }
+      // Out of budget with the bound not met: the cut's error may exceed --error (counted,
+      // and the render warns).
+      if (cutSize >= maxCut) {
+        ++stats.cutsAtMaxCut;
+        break;
       }
       heapPop(heap);
       const CutNode cn = nodes[uint32_t(top)];

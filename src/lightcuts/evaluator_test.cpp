@@ -197,6 +197,24 @@ TEST(Lightcuts, RefinesTheLargestBoundFirst) {
   }
 }
 
+// A cut that runs out of --max-cut nodes before its bound holds is counted; one that holds
+// its bound, or reaches every light, is not.
+TEST(Lightcuts, CountsCutsStoppedByTheBudget) {
+  LightSet s = cloud(2000, LightType::Oriented, 6);
+  LightForest f = buildLightForest(s);
+  Unoccluded vis;
+  ShadingPoint sp = point(Vec3(0.3f, 0, -0.2f));
+  auto count = [&](float error, int maxCut) {
+    auto lc = makeLightcuts(s, f, CutOptions{error, maxCut});
+    EvalStats st;
+    lc->evaluate(sp, vis, st);
+    return st.cutsAtMaxCut;
+  };
+  EXPECT_EQ(count(0.0f, 100), 1u);      // an exact cut wanted, 100 nodes allowed
+  EXPECT_EQ(count(0.0f, 1 << 30), 0u);  // every light reached
+  EXPECT_EQ(count(0.02f, 4000), 0u);    // the bound holds well before 4000
+}
+
 TEST(CourseCuts, ZeroThresholdReachesEveryLight) {
   LightSet s = cloud(200, LightType::Omni, 5);
   LightForest f = buildLightForest(s, TreeBuildOptions{TreeBuilder::Course, 1});
