@@ -68,7 +68,7 @@ REFERENCE_KEYS = ["pixels", "mean_relative_error", "p99_relative_error", "max_re
                   "fraction_over_threshold", "threshold", "brute_lights_per_shading_point"]
 # Counters that tiles sharing reconstruction samples make timing-dependent; stable without them.
 COUNTER_KEYS = ["primary_rays", "secondary_rays", "shadow_rays", "shading_points", "avg_lights_per_shading_point",
-                "bounds_evaluated", "cut_histogram", "aa_sub_samples", "reconstructed_points"]
+                "bounds_evaluated", "cut_histogram", "aa_sub_samples", "reconstructed_points", "cuts_at_max_cut"]
 
 
 def run(binary, folder, scene, flags, size, threads):
