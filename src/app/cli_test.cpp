@@ -486,7 +486,8 @@ TEST(CliUsage, RenderHelpIsGroupedAndStatesEveryDefault) {
     EXPECT_NE(entry.find("default"), std::string::npos) << "no default stated: " << entry;
   }
   // A few values, as the code defines them.
-  EXPECT_NE(h.find("Most nodes in one cut; default 16000"), std::string::npos) << h;
+  EXPECT_NE(h.find("Most nodes in one cut (a cut stopped there has not met --error"), std::string::npos) << h;
+  EXPECT_NE(h.find("with a warning over 0.1% of the cuts); default 16000"), std::string::npos) << h;
   EXPECT_NE(h.find("default 512, or from --height"), std::string::npos) << h;
   EXPECT_NE(h.find("Limit on VPLs; default 10000000"), std::string::npos) << h;
   EXPECT_NE(h.find("default auto: 4 for images of 512 x 512 pixels or more"), std::string::npos) << h;

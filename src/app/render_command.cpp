@@ -617,7 +617,9 @@ void addRenderCommand(CLI::App& app) {
                             "(default {})", kLightcutsDefaultError, kCourseDefaultError))
       ->check(CLI::Range(0.0, 1e6))
       ->group(cuts);
-  c->add_option("--max-cut", a->maxCut, fmt::format("Most nodes in one cut; default {}", d.maxCut))
+  c->add_option("--max-cut", a->maxCut, fmt::format("Most nodes in one cut (a cut stopped there has not met --error: counted in "
+                            "--stats as cuts_at_max_cut, with a warning over {:g}% of the cuts); default {}",
+                            100 * kMaxCutShare, d.maxCut))
       ->check(CLI::Range(1, 1 << 30))
       ->group(cuts);
   c->add_option("--error-floor", a->errorFloor,
