@@ -8,18 +8,14 @@ review of the coin and separation changes.
   /usr/bin/python3 scripts/gen_blinds.py SEED N OUT.ray
 """
 import os
-import random
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gen_scenes import box  # noqa: E402
+from gen_scenes import box, seeded_args, write_lines  # noqa: E402
 
 
 def main(argv):
-    if len(argv) != 4:
-        sys.exit(__doc__)
-    rng = random.Random(int(argv[1]))
-    n = int(argv[2])
+    rng, n, out = seeded_args(argv, __doc__)
     o = ["SBT-raytracer 1.0",
          "camera { position = (2.6, 1.5, -2.2); look_at = (-2.0, 1.0, 0.3); fov = 60; }",
          "material = { name = wall; diffuse = (0.75, 0.73, 0.7); }",
@@ -63,8 +59,7 @@ def main(argv):
             col, k = (0.6, 0.75, 1.0), 1.0
         o.append("point_light { position = (%.4f, %.4f, %.4f); colour = (%g, %g, %g); }"
                  % (p[0], p[1], p[2], 150.0 / n * k * col[0], 150.0 / n * k * col[1], 150.0 / n * k * col[2]))
-    with open(argv[3], "w") as f:
-        f.write("\n".join(o) + "\n")
+    write_lines(out, o)
 
 
 if __name__ == "__main__":

@@ -31,6 +31,7 @@ scripts/gen_scaling_scene.py.
 import argparse
 import math
 import os
+import random
 import re
 import sys
 
@@ -158,6 +159,20 @@ class Mesh:
         block("faces", self.f, lambda t: "(%d, %d, %d)" % t)
         out.append("}\n")
         return "".join(out)
+
+
+def seeded_args(argv, doc):
+    """The arguments SEED N OUT of a random scene's generator: random.Random(SEED), N and OUT;
+    exits with `doc` (its usage) for any other count."""
+    if len(argv) != 4:
+        sys.exit(doc)
+    return random.Random(int(argv[1])), int(argv[2]), argv[3]
+
+
+def write_lines(path, lines):
+    """Writes `lines` to `path`, one per line."""
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
 
 
 def box(center, size, mat, rot_y=0.0, rot_z=0.0):

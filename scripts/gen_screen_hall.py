@@ -9,18 +9,14 @@ a quarter scattered anywhere. Written after the visibility coin's weight was der
   /usr/bin/python3 scripts/gen_screen_hall.py SEED N OUT.ray
 """
 import os
-import random
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gen_scenes import box  # noqa: E402
+from gen_scenes import box, seeded_args, write_lines  # noqa: E402
 
 
 def main(argv):
-    if len(argv) != 4:
-        sys.exit(__doc__)
-    rng = random.Random(int(argv[1]))
-    n = int(argv[2])
+    rng, n, out = seeded_args(argv, __doc__)
     o = ["SBT-raytracer 1.0",
          "camera { position = (-4.6, 1.7, 5.4); look_at = (0.5, 1.2, -0.5); fov = 62; }",
          "material = { name = plaster; diffuse = (0.72, 0.7, 0.66); }",
@@ -78,8 +74,7 @@ def main(argv):
     for p, col, k in lights:
         o.append("point_light { position = (%.4f, %.4f, %.4f); colour = (%g, %g, %g); }"
                  % (p[0], p[1], p[2], scale * k * col[0], scale * k * col[1], scale * k * col[2]))
-    with open(argv[3], "w") as f:
-        f.write("\n".join(o) + "\n")
+    write_lines(out, o)
 
 
 if __name__ == "__main__":
