@@ -168,7 +168,8 @@ ReconstructionTile::ReconstructionTile(ReconstructionRender& render, const TileR
       x1_(rect.x1), y1_(rect.y1) {
   const scene::Camera& cam = r_.scene.camera();
   Vec3 a = normalize(cam.direction(0.5f, 0.5f)), b = normalize(cam.direction(0.5f + 1.0f / float(o_.width), 0.5f));
-  maxSeparation_ = kSampleMaxFootprints * float(r_.spacing) * length(a - b);
+  pixelAngle_ = length(a - b);
+  maxSeparation_ = kSampleMaxFootprints * float(r_.spacing) * pixelAngle_;
 }
 
 const CutSample& ReconstructionTile::sample(int x, int y) {
@@ -331,6 +332,36 @@ void ReconstructionTile::cellPixels(int cx, int cy, int w, int h) {
   if (w > w0 && h > h0) cellPixels(cx + w0, cy + h0, w - w0, h - h0);
 }
 
+// Whether a surface lies near a sub-sample that borrows from samples it lies beyond
+// (kExtrapolationReach in reconstruction_tiles.h): the world distance from the hit to the
+// nearest segment between two samples (or to the sample, for one), and, when that is over
+// kExtrapolationMinFootprints pixel footprints, short occlusion rays from the hit.
+bool ReconstructionTile::surfaceNear(const Hit& hit, const CutSample* const* chosen, int k, PrimaryHook& hook) const {
+  float d2 = kInf;
+  for (int i = 0; i < k; ++i)
+    for (int j = i; j < k; ++j) {
+      const Vec3 a = chosen[i]->p, e = chosen[j]->p - a;
+      const float ee = dot(e, e);
+      const float t = ee > 0 ? std::clamp(dot(hit.p - a, e) / ee, 0.0f, 1.0f) : 0.0f;
+      d2 = std::min(d2, length2(hit.p - (a + e * t)));
+    }
+  const float footprint = pixelAngle_ * length(hit.p - r_.scene.camera().eye);
+  const float d = std::sqrt(d2);
+  if (!(d > kExtrapolationMinFootprints * footprint)) return false;
+  const Vec3 o = hit.p + hit.ns * (kSeparationLift * r_.scene.epsilon());
+  Vec3 u, v;
+  orthonormalBasis(hit.ns, u, v);
+  const Vec3 dirs[kExtrapolationRays] = {hit.ns, normalize(hit.ns + u), normalize(hit.ns - u), normalize(hit.ns + v),
+                                         normalize(hit.ns - v)};
+  static_assert(kExtrapolationRays == 5);
+  const float reach = kExtrapolationReach * d;
+  for (const Vec3& dir : dirs) {
+    ++hook.separationRays;
+    if (r_.scene.occluded(o, dir, reach)) return true;
+  }
+  return false;
+}
+
 void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, PrimaryHook& hook,
                                        const CutSample** chosen, AaCutCache& cache) const {
   const scene::Camera& cam = r_.scene.camera();
@@ -388,7 +419,9 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
       ++k;
     }
     hook.count = k;
-    if (k > 0 && !(nearest <= 1 || insideSamples(hook, (1u << k) - 1))) hook.count = 0;
+    if (k > 0 && !insideSamples(hook, (1u << k) - 1)) {
+      if (nearest > 1 || (o_.aaExtrapolationProbe && surfaceNear(hit, chosen, k, hook))) hook.count = 0;
+    }
     // A sample on the sub-sample's surface but cut off from it by another surface (the
     // segment between them, lifted off the surface, is blocked: a screen's crossbar across
     // the face of its upright, a box standing on a floor) may see lights the sub-sample

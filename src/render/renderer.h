@@ -119,6 +119,14 @@ struct RenderOptions {
   // a full cut instead of borrowing (ReconstructionTile::subSampleHook). On by default: a
   // pierced screen, 0.98% -> 0.68% of pixels over 2%, +8% shadow rays.
   bool aaSeparationTest = true;
+  // Antialiasing under reconstruction cuts: a sub-sample outside its samples' hull (which
+  // it may be when one of them is a neighbouring pixel's) probes for a surface near it,
+  // within a reach proportional to how far it lies beyond them (a few short occlusion
+  // rays, counted as shadow rays); if one is there, it takes a full cut instead of
+  // borrowing (kExtrapolationReach in reconstruction_tiles.h). On by default: an unseen
+  // fence seen edge on, 6.2% -> 0.39% of pixels over 2%, blinds 1.03% -> 0.83%; shadow
+  // rays per point +3% to +30% on interiors, +19% on the Cornell box.
+  bool aaExtrapolationProbe = true;
   // Luminance floor of lightcuts' relative error criterion (ShadingPoint::errorFloor): a
   // cut stops when its error bound is within error x max(estimate, floor), so pixels far
   // darker than the image are held to an absolute error, as the image metric does (its
