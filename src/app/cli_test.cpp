@@ -1400,6 +1400,13 @@ TEST(CliOutput, AdaptiveAntialiasingByDefault) {
   nlohmann::json more = stats({"--aa-samples", "24"});
   EXPECT_EQ(more["primary_rays"].get<int>(), 32 * 32 + 24 * more["aa_pixels"].get<int>());
   EXPECT_EQ(more["aa_pixels"], d["aa_pixels"]);
+  // The probe for a surface near sub-samples beyond their samples: on by default; off, it
+  // sends no rays, so no more shadow rays than on (reconstruction forced at this size).
+  EXPECT_EQ(d["aa_extrapolation_probe"], true);
+  nlohmann::json probed = stats({"--reconstruct", "4"});
+  nlohmann::json unprobed = stats({"--reconstruct", "4", "--aa-extrapolation-probe", "off"});
+  EXPECT_EQ(unprobed["aa_extrapolation_probe"], false);
+  EXPECT_LE(unprobed["shadow_rays"].get<double>(), probed["shadow_rays"].get<double>());
   CliResult bad = run({"render", "s.ray", "-o", "b.png", "--width", "8", "-q", "--aa-samples", "16"}, dir.path());
   EXPECT_NE(bad.status, 0);
   // --aov samples: 81 at the re-sampled pixels, 1 elsewhere; --spp N everywhere.

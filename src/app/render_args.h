@@ -21,6 +21,7 @@ struct RenderArgs {
   int spp = render::RenderOptions{}.spp;
   render::AntiAliasing aa = render::RenderOptions{}.aa;
   int aaSamples = render::RenderOptions{}.aaSamples;
+  bool aaExtrapolationProbe = render::RenderOptions{}.aaExtrapolationProbe;
   std::string aov;  // comma-separated kAovNames
   int threads = 0;
   int maxDepth = 5;

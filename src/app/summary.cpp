@@ -158,6 +158,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["height"] = a.height;
   j["spp"] = a.spp;
   j["aa"] = render::antiAliasingName(a.spp == 1 ? a.aa : render::AntiAliasing::Off);
+  j["aa_extrapolation_probe"] = a.aaExtrapolationProbe;
   j["aa_samples"] = a.aaSamples;
   j["aa_pixels"] = rr.stats.aaPixels;
   j["aa_seam_pixels"] = rr.stats.aaSeamPixels;  // of aa_pixels, flagged across tile borders
