@@ -319,16 +319,24 @@ TEST(Accuracy, CellsSplitWhereTheirSamplesDisagreeCatchShadowsBetweenThem) {
 // lights low on both sides: each board's two sides of the floor see different lights, so
 // an antialiasing sub-sample beside a board must not borrow from a sample across it
 // (RenderOptions::aaSeparationTest).
-TEST(Accuracy, SubSamplesCutOffFromTheirSamplesTakeFullCuts) {
+// A fence of `boards` upright boards (thickness x height x 3), `pitch` apart and centred,
+// standing on a floor seen from above, lit by 300 low point lights on both sides.
+std::string fenceScene(int boards, float pitch, float thickness, float height) {
   std::mt19937 rng(11);
   auto u = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
   std::string t = "SBT-raytracer 1.0\ncamera { position = (0, 3, 0.01); look_at = (0, 0, 0); fov = 45; }\n";
   t += box(0, -0.05f, 0, 4, 0.1f, 4, 0, "{ diffuse = (0.6, 0.6, 0.6); }");
-  for (int k = 0; k < 7; ++k) t += box(-0.9f + 0.3f * float(k), 0.2f, 0, 0.03f, 0.4f, 3, 0, "{ diffuse = (0.3, 0.3, 0.3); }");
+  for (int k = 0; k < boards; ++k)
+    t += box(pitch * (float(k) - 0.5f * float(boards - 1)), 0.5f * height, 0, thickness, height, 3, 0,
+             "{ diffuse = (0.3, 0.3, 0.3); }");
   for (int i = 0; i < 300; ++i)
     t += "point_light { position = (" + std::to_string(u(-2, 2)) + "," + std::to_string(u(0.1f, 0.6f)) + "," +
          std::to_string(u(-1.5f, 1.5f)) + "); colour = (0.01, 0.01, 0.01); }\n";
-  Evaluated e(t);
+  return t;
+}
+
+TEST(Accuracy, SubSamplesCutOffFromTheirSamplesTakeFullCuts) {
+  Evaluated e(fenceScene(7, 0.3f, 0.03f, 0.4f));
   const scene::Scene* s = e.scene.get();
   const lightcuts::LightEvaluator* lc = e.lc.get();
   RenderOptions o;
@@ -353,15 +361,7 @@ TEST(Accuracy, SubSamplesCutOffFromTheirSamplesTakeFullCuts) {
 // hides other lights. With the probe for a surface near such a sub-sample
 // (RenderOptions::aaExtrapolationProbe) they take full cuts.
 TEST(Accuracy, SubSamplesBeyondTheirSamplesNearASurfaceTakeFullCuts) {
-  std::mt19937 rng(11);
-  auto u = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
-  std::string t = "SBT-raytracer 1.0\ncamera { position = (0, 3, 0.01); look_at = (0, 0, 0); fov = 45; }\n";
-  t += box(0, -0.05f, 0, 4, 0.1f, 4, 0, "{ diffuse = (0.6, 0.6, 0.6); }");
-  for (int k = 0; k < 25; ++k) t += box(-0.72f + 0.06f * float(k), 0.1f, 0, 0.012f, 0.2f, 3, 0, "{ diffuse = (0.3, 0.3, 0.3); }");
-  for (int i = 0; i < 300; ++i)
-    t += "point_light { position = (" + std::to_string(u(-2, 2)) + "," + std::to_string(u(0.1f, 0.6f)) + "," +
-         std::to_string(u(-1.5f, 1.5f)) + "); colour = (0.01, 0.01, 0.01); }\n";
-  Evaluated e(t);
+  Evaluated e(fenceScene(25, 0.06f, 0.012f, 0.2f));
   RenderOptions o;
   o.width = o.height = 256;
   o.reconstructSpacing = 4;
