@@ -576,7 +576,7 @@ void addRenderCommand(CLI::App& app) {
     addSwitch(*c, "--aa-extrapolation-probe", a->aaExtrapolationProbe,
               fmt::format("Adaptive antialiasing under reconstruction cuts: a sub-sample beyond the samples it "
                           "borrows from sends a few short rays for a surface near it, and takes a full lightcut if "
-                          "one is there (edge-on faces, slats, creases: fewer pixels over --error, 5-30% more shadow "
+                          "one is there (edge-on faces, slats, creases: fewer pixels over --error, 3-30% more shadow "
                           "rays); off borrows regardless; default {}",
                           switchName(d.aaExtrapolationProbe)))
         ->group(image);
