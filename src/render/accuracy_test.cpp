@@ -315,10 +315,6 @@ TEST(Accuracy, CellsSplitWhereTheirSamplesDisagreeCatchShadowsBetweenThem) {
   for (uint8_t d : split.done) ASSERT_EQ(d, 1);
 }
 
-// A floor seen from above, crossed by a fence of upright boards standing on it, lit by
-// lights low on both sides: each board's two sides of the floor see different lights, so
-// an antialiasing sub-sample beside a board must not borrow from a sample across it
-// (RenderOptions::aaSeparationTest).
 // A fence of `boards` upright boards (thickness x height x 3), `pitch` apart and centred,
 // standing on a floor seen from above, lit by 300 low point lights on both sides.
 std::string fenceScene(int boards, float pitch, float thickness, float height) {
@@ -335,6 +331,10 @@ std::string fenceScene(int boards, float pitch, float thickness, float height) {
   return t;
 }
 
+// A floor seen from above, crossed by a fence of upright boards standing on it, lit by
+// lights low on both sides: each board's two sides of the floor see different lights, so
+// an antialiasing sub-sample beside a board must not borrow from a sample across it
+// (RenderOptions::aaSeparationTest).
 TEST(Accuracy, SubSamplesCutOffFromTheirSamplesTakeFullCuts) {
   Evaluated e(fenceScene(7, 0.3f, 0.03f, 0.4f));
   const scene::Scene* s = e.scene.get();
