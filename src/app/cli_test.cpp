@@ -1407,6 +1407,12 @@ TEST(CliOutput, AdaptiveAntialiasingByDefault) {
   nlohmann::json unprobed = stats({"--reconstruct", "4", "--aa-extrapolation-probe", "off"});
   EXPECT_EQ(unprobed["aa_extrapolation_probe"], false);
   EXPECT_LE(unprobed["shadow_rays"].get<double>(), probed["shadow_rays"].get<double>());
+  // Sub-samples' full cuts as samples for the rest of their pixel: on by default; off,
+  // every such sub-sample takes its own full cut, so no fewer than on.
+  EXPECT_EQ(d["aa_pixel_samples"], true);
+  nlohmann::json unshared = stats({"--reconstruct", "4", "--aa-pixel-samples", "off"});
+  EXPECT_EQ(unshared["aa_pixel_samples"], false);
+  EXPECT_GE(unshared["reconstruction_fallbacks"].get<double>(), probed["reconstruction_fallbacks"].get<double>());
   CliResult bad = run({"render", "s.ray", "-o", "b.png", "--width", "8", "-q", "--aa-samples", "16"}, dir.path());
   EXPECT_NE(bad.status, 0);
   // --aov samples: 81 at the re-sampled pixels, 1 elsewhere; --spp N everywhere.

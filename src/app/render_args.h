@@ -22,6 +22,7 @@ struct RenderArgs {
   render::AntiAliasing aa = render::RenderOptions{}.aa;
   int aaSamples = render::RenderOptions{}.aaSamples;
   bool aaExtrapolationProbe = render::RenderOptions{}.aaExtrapolationProbe;
+  bool aaPixelSamples = render::RenderOptions{}.aaPixelSamples;
   std::string aov;  // comma-separated kAovNames
   int threads = 0;
   int maxDepth = 5;

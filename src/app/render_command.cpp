@@ -304,6 +304,7 @@ render::RenderOptions renderOptions(const RenderArgs& a, lightcuts::Method metho
   ro.aa = a.aa;
   ro.aaSamples = a.aaSamples;
   ro.aaExtrapolationProbe = a.aaExtrapolationProbe;
+  ro.aaPixelSamples = a.aaPixelSamples;
   ro.threads = a.threads;
   ro.maxDepth = a.maxDepth;
   ro.seed = a.seed;
@@ -579,6 +580,12 @@ void addRenderCommand(CLI::App& app) {
                           "one is there (edge-on faces, slats, creases: fewer pixels over --error, 3-30% more shadow "
                           "rays); off borrows regardless; default {}",
                           switchName(d.aaExtrapolationProbe)))
+        ->group(image);
+    addSwitch(*c, "--aa-pixel-samples", a->aaPixelSamples,
+              fmt::format("Adaptive antialiasing under reconstruction cuts: a sub-sample that takes a full "
+                          "lightcut becomes a sample for the rest of its pixel (creases and edges: fewer full "
+                          "cuts); off, each such sub-sample takes its own; default {}",
+                          switchName(d.aaPixelSamples)))
         ->group(image);
   }
   c->add_option("--aov", a->aov,

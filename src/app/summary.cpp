@@ -159,6 +159,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["spp"] = a.spp;
   j["aa"] = render::antiAliasingName(a.spp == 1 ? a.aa : render::AntiAliasing::Off);
   j["aa_extrapolation_probe"] = a.aaExtrapolationProbe;
+  j["aa_pixel_samples"] = a.aaPixelSamples;
   j["aa_samples"] = a.aaSamples;
   j["aa_pixels"] = rr.stats.aaPixels;
   j["aa_seam_pixels"] = rr.stats.aaSeamPixels;  // of aa_pixels, flagged across tile borders

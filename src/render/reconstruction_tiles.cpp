@@ -28,6 +28,12 @@ void CellCuts::reset() {
 void AaCutCache::reset() {
   for (CellCuts& e : entries) e.reset();
   next = 0;
+  pixel.count = 0;
+}
+
+void AaCutCache::forget(const CutSample* s) {
+  for (CellCuts& e : entries)
+    if (e.aaCount > 0 && std::find(e.aaSamples, e.aaSamples + e.aaCount, s) != e.aaSamples + e.aaCount) e.reset();
 }
 
 CellCuts* AaCutCache::find(const CutSample* const* set, int k) {
@@ -90,6 +96,7 @@ unsigned servingSamples(const PrimaryHook& h, int shape, const Vec3& p, const Ve
 
 EvalResult PrimaryHook::light(const Hit& h, const ShadingPoint& sp, lightcuts::Visibility& vis, EvalStats& stats) {
   if (record) {
+    fallbacks += recordFallback;
     record->shape = h.shape;
     record->p = h.p;
     record->n = h.ns;
@@ -335,8 +342,9 @@ void ReconstructionTile::cellPixels(int cx, int cy, int w, int h) {
 // Whether a surface lies near a sub-sample that borrows from samples it lies beyond
 // (kExtrapolationReach in reconstruction_tiles.h): the world distance from the hit to the
 // nearest segment between two samples (or to the sample, for one), and, when that is over
-// kExtrapolationMinFootprints pixel footprints, short occlusion rays from the hit.
-bool ReconstructionTile::surfaceNear(const Hit& hit, const CutSample* const* chosen, int k, PrimaryHook& hook) const {
+// `gate` pixel footprints, short occlusion rays from the hit.
+bool ReconstructionTile::surfaceNear(const Hit& hit, const CutSample* const* chosen, int k, PrimaryHook& hook,
+                                     float gate) const {
   float d2 = kInf;
   for (int i = 0; i < k; ++i)
     for (int j = i; j < k; ++j) {
@@ -347,7 +355,7 @@ bool ReconstructionTile::surfaceNear(const Hit& hit, const CutSample* const* cho
     }
   const float footprint = pixelAngle_ * length(hit.p - r_.scene.camera().eye);
   const float d = std::sqrt(d2);
-  if (!(d > kExtrapolationMinFootprints * footprint)) return false;
+  if (!(d > gate * footprint)) return false;
   const Vec3 o = hit.p + hit.ns * (kSeparationLift * r_.scene.epsilon());
   Vec3 u, v;
   orthonormalBasis(hit.ns, u, v);
@@ -379,24 +387,32 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
   if (r_.scene.intersect(ray, hit)) {
     const float far2 = length2(hit.p - cam.eye) * maxSeparation_ * maxSeparation_;
     const int R = 2 * std::max(1, r_.spacing);
-    int bd[4] = {INT32_MAX, INT32_MAX, INT32_MAX, INT32_MAX}, bx[4] = {}, by[4] = {};
+    // Per quadrant: the nearest sample's squared distance, position (sub-pixel units) and
+    // pixel distance (Chebyshev; 0 for the pixel's own samples).
+    int bd[4] = {INT32_MAX, INT32_MAX, INT32_MAX, INT32_MAX}, bx[4] = {}, by[4] = {}, bp[4] = {};
     const CutSample* best[4] = {};
+    auto consider = [&](const CutSample* cs, int sx, int sy, int pixels, float reach2) {
+      if (!cs || !cs->cut.valid || !sameSurface(hit.shape, hit.p, hit.ns, cs->shape, cs->p, cs->n) ||
+          length2(cs->p - hit.p) > reach2)
+        return;
+      // Quadrants and distances around the sub-sample's own position.
+      const int dx = sx - hook.px, dy = sy - hook.py, d = dx * dx + dy * dy;
+      for (int q = 0; q < 4; ++q)
+        if (((q & 1) ? dx >= 0 : dx <= 0) && ((q & 2) ? dy >= 0 : dy <= 0) && d < bd[q]) {
+          bd[q] = d;
+          best[q] = cs;
+          bx[q] = sx;
+          by[q] = sy;
+          bp[q] = pixels;
+        }
+    };
     for (int Y = std::max(y0_, y - R); Y <= std::min({y1_, y + R, o_.height - 1}); ++Y)
-      for (int X = std::max(x0_, x - R); X <= std::min({x1_, x + R, o_.width - 1}); ++X) {
-        const CutSample* cs = scratch_.shared[slot(X, Y)];
-        if (!cs || !cs->cut.valid || !sameSurface(hit.shape, hit.p, hit.ns, cs->shape, cs->p, cs->n) ||
-            length2(cs->p - hit.p) > far2)
-          continue;
-        // Quadrants and distances around the sub-sample's own position.
-        const int dx = X * kSub + kSub / 2 - hook.px, dy = Y * kSub + kSub / 2 - hook.py, d = dx * dx + dy * dy;
-        for (int q = 0; q < 4; ++q)
-          if (((q & 1) ? dx >= 0 : dx <= 0) && ((q & 2) ? dy >= 0 : dy <= 0) && d < bd[q]) {
-            bd[q] = d;
-            best[q] = cs;
-            bx[q] = X;
-            by[q] = Y;
-          }
-      }
+      for (int X = std::max(x0_, x - R); X <= std::min({x1_, x + R, o_.width - 1}); ++X)
+        consider(scratch_.shared[slot(X, Y)], X * kSub + kSub / 2, Y * kSub + kSub / 2,
+                 std::max(std::abs(X - x), std::abs(Y - y)), far2);
+    PixelSamples& own = cache.pixel;
+    const float ownReach = kPixelSampleMaxFootprints * pixelAngle_ * length(hit.p - cam.eye);
+    for (int i = 0; i < own.count; ++i) consider(&own.slot[i], own.px[i], own.py[i], 0, ownReach * ownReach);
     // Distinct, in image order (one set, one order: its merged cuts are cached).
     int order[4], n = 0;
     for (int q = 0; q < 4; ++q) {
@@ -413,14 +429,17 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
     for (int j = 0; j < n; ++j) {
       const int q = order[j];
       chosen[k] = best[q];
-      hook.cx[k] = bx[q] * kSub + kSub / 2;
-      hook.cy[k] = by[q] * kSub + kSub / 2;
-      nearest = std::min(nearest, std::max(std::abs(bx[q] - x), std::abs(by[q] - y)));
+      hook.cx[k] = bx[q];
+      hook.cy[k] = by[q];
+      nearest = std::min(nearest, bp[q]);
       ++k;
     }
     hook.count = k;
+    bool usesOwn = false;  // a pixel sample: a surface was near enough for a full cut there
+    for (int i = 0; i < k; ++i) usesOwn |= chosen[i] >= own.slot && chosen[i] < own.slot + PixelSamples::kMax;
     if (k > 0 && !insideSamples(hook, (1u << k) - 1)) {
-      if (nearest > 1 || (o_.aaExtrapolationProbe && surfaceNear(hit, chosen, k, hook))) hook.count = 0;
+      const float gate = usesOwn ? kPixelSampleMinFootprints : kExtrapolationMinFootprints;
+      if (nearest > 1 || (o_.aaExtrapolationProbe && surfaceNear(hit, chosen, k, hook, gate))) hook.count = 0;
     }
     // A sample on the sub-sample's surface but cut off from it by another surface (the
     // segment between them, lifted off the surface, is blocked: a screen's crossbar across
@@ -441,6 +460,17 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
         ++hook.separationRays;
         if (r_.scene.occluded(a, d / len, len)) hook.count = 0;
       }
+    }
+    // A full cut: recorded as one of the pixel's samples while there is room.
+    if (hook.count == 0 && o_.aaPixelSamples && own.count < PixelSamples::kMax) {
+      CutSample* s = &own.slot[own.count];
+      cache.forget(s);
+      s->cut.clear();
+      own.px[own.count] = hook.px;
+      own.py[own.count] = hook.py;
+      ++own.count;
+      hook.record = s;
+      hook.recordFallback = true;
     }
   }
   hook.cell = cache.find(chosen, hook.count);

@@ -120,15 +120,41 @@ struct CellCuts {
   void reset();
 };
 
+// Samples inside one antialiased pixel (RenderOptions::aaPixelSamples): the full cuts its
+// sub-samples took where no sample could serve them (beyond their samples near a surface,
+// cut off from them, or none near), each recorded as a sample at the sub-sample's position
+// for the pixel's later sub-samples, in their fixed order (so the image depends on nothing
+// else). Where one sub-sample on a crease or along a board's side face needs a full cut,
+// its neighbours in the pixel mostly do too; with it as a sample they lie near one, and
+// borrow. Samples gather where the image needs them, as cells split (Walter et al. 2005,
+// sec. 5). A pixel sample serves sub-samples within kPixelSampleMaxFootprints of it (a
+// face seen edge on spreads a pixel far across the world), and a sub-sample that uses one
+// and lies beyond its samples probes for a surface near it from kPixelSampleMinFootprints
+// on, not kExtrapolationMinFootprints: a surface was near enough for a full cut where the
+// pixel sample is, and hard shadows there change within a fraction of a pixel (an unseen
+// fence seen edge on: 0.5 footprints put 1.42% of pixels over 2%, 0.25 0.45%, against
+// 1.13% without pixel samples; docs/LIGHTCUTS.md, "Samples inside a pixel").
+constexpr float kPixelSampleMaxFootprints = 2.0f;
+constexpr float kPixelSampleMinFootprints = 0.25f;
+struct PixelSamples {
+  static constexpr int kMax = 8;
+  CutSample slot[kMax];
+  int px[kMax] = {}, py[kMax] = {};  // their positions, in the hull test's sub-pixel units
+  int count = 0;
+};
+
 // The merged cuts of the last few sets of samples antialiasing's sub-samples borrowed from
 // (neighbouring sub-samples, and pixels, mostly borrow from the same ones), replaced in
-// turn.
+// turn; and the current pixel's own samples.
 struct AaCutCache {
   static constexpr int kEntries = 8;
   CellCuts entries[kEntries];
   int next = 0;
+  PixelSamples pixel;
   void reset();
   CellCuts* find(const CutSample* const* set, int k);
+  // Drops the merged cuts that use `s` (a pixel sample about to be recorded anew).
+  void forget(const CutSample* s);
 };
 
 // What happens at a primary hit under reconstruction cuts: the hit records its lightcut as
@@ -144,6 +170,7 @@ struct PrimaryHook final : PrimaryLight {
   int px = 0, py = 0;         // the pixel, and
   int cx[4] = {}, cy[4] = {};  // the samples' pixels
   bool preselected = false;  // samples chosen for this very hit (antialiasing): no hull test
+  bool recordFallback = false;  // `record` is a pixel sample (PixelSamples): count it a fallback
   uint64_t fallbacks = 0;  // hits no sample could serve: they got a full lightcut
   uint64_t separationRays = 0;  // antialiasing: rays that tested its samples for being cut off,
                                 // and for a surface near the sub-sample beyond their hull
@@ -247,8 +274,9 @@ class ReconstructionTile {
   // it gets a full lightcut. (Quadrants around the pixel instead let the pixel's own
   // sample, where it is one, win all four, and sub-samples on a contact line borrowed from
   // it alone: up to 13% off.) One beyond its samples (the neighbouring pixel's case) also
-  // gets a full lightcut where a surface lies near it (surfaceNear). `chosen` holds the
-  // samples; the merged cuts come from `cache`.
+  // gets a full lightcut where a surface lies near it (surfaceNear). A sub-sample that gets
+  // a full lightcut becomes one of the pixel's own samples (PixelSamples, in `cache`) for
+  // the sub-samples after it. `chosen` holds the samples; the merged cuts come from `cache`.
   void subSampleHook(const scene::Ray& ray, int x, int y, Vec2 u, PrimaryHook& hook, const CutSample** chosen,
                      AaCutCache& cache) const;
 
@@ -257,7 +285,8 @@ class ReconstructionTile {
   const CutSample& sample(int x, int y);
   std::optional<float> cornersDisagreement(const CutSample* const* corners, int n);
   bool probe(int x, int y, int& shape, Vec3& p, Vec3& n) const;
-  bool surfaceNear(const scene::Hit& hit, const CutSample* const* chosen, int k, PrimaryHook& hook) const;
+  bool surfaceNear(const scene::Hit& hit, const CutSample* const* chosen, int k, PrimaryHook& hook,
+                   float gate) const;
   void cellPixels(int cx, int cy, int w, int h);
 
   ReconstructionRender& r_;
