@@ -132,8 +132,9 @@ struct RenderOptions {
   // serves it) is recorded as a sample for the rest of its pixel's sub-samples (PixelSamples
   // in reconstruction_tiles.h). On by default: where one sub-sample on a crease or a board's
   // edge needs a full cut its neighbours mostly do too, and now borrow from it instead. The
-  // Cornell box's full cuts at sub-samples 14,512 -> 5,113 (shadow rays per point -10%), an
-  // unseen fence's pixels over 2% 1.08% -> 0.77%.
+  // Cornell box's full cuts at sub-samples 14,512 -> 6,983 (shadow rays per point -8%), an
+  // unseen fence's pixels over 2% 1.08% -> 0.74%, the Roman hall's shadow rays -33%
+  // (docs/LIGHTCUTS.md, "Samples inside a pixel").
   bool aaPixelSamples = true;
   // Luminance floor of lightcuts' relative error criterion (ShadingPoint::errorFloor): a
   // cut stops when its error bound is within error x max(estimate, floor), so pixels far
