@@ -583,8 +583,8 @@ void addRenderCommand(CLI::App& app) {
         ->group(image);
     addSwitch(*c, "--aa-pixel-samples", a->aaPixelSamples,
               fmt::format("Adaptive antialiasing under reconstruction cuts: a sub-sample that takes a full "
-                          "lightcut becomes a sample for the rest of its pixel (creases and edges: fewer full "
-                          "cuts); off, each such sub-sample takes its own; default {}",
+                          "lightcut becomes a sample for the rest of its pixel and the next ones (creases and "
+                          "edges: fewer full cuts); off, each such sub-sample takes its own; default {}",
                           switchName(d.aaPixelSamples)))
         ->group(image);
   }

@@ -381,9 +381,9 @@ TEST(Accuracy, SubSamplesBeyondTheirSamplesNearASurfaceTakeFullCuts) {
 }
 
 // The same fence: sub-samples beyond their samples along a board's side face take full
-// cuts, a few in each such pixel. With each full cut a sample for the rest of its pixel
-// (RenderOptions::aaPixelSamples), its neighbours borrow from it, or probe sooner for the
-// next board: fewer full cuts and shadow rays, and less error.
+// cuts, a few in each such pixel. With each full cut a sample for the sub-samples after it
+// in its pixel and the next pixels (RenderOptions::aaPixelSamples), they borrow from it, or
+// probe sooner for the next board: fewer full cuts and shadow rays, and less error.
 TEST(Accuracy, SubSamplesFullCutsServeTheRestOfTheirPixel) {
   Evaluated e(fenceScene(25, 0.06f, 0.012f, 0.2f));
   RenderOptions o;
@@ -394,12 +394,12 @@ TEST(Accuracy, SubSamplesFullCutsServeTheRestOfTheirPixel) {
   RenderResult own = render(*e.scene, *e.lc, o);
   o.aaPixelSamples = true;
   RenderResult shared = render(*e.scene, *e.lc, o);
-  // Measured: full cuts 216,918 -> 123,592, shadow rays -19%, reference pixels over 2%
-  // 1.88% -> 1.12%, the worst pixel the same (12%).
-  EXPECT_LT(shared.stats.reconstructionFallbacks * 3, own.stats.reconstructionFallbacks * 2);
+  // Measured: full cuts 216,918 -> 106,169, shadow rays -22%, reference pixels over 2%
+  // 1.88% -> 0.63%, the worst pixel 12.2% -> 8.6%.
+  EXPECT_LT(shared.stats.reconstructionFallbacks * 2, own.stats.reconstructionFallbacks);
   EXPECT_LT(shared.stats.eval.shadowRays * 10, own.stats.eval.shadowRays * 9);
-  EXPECT_LT(shared.stats.reference.fractionOver2pct, own.stats.reference.fractionOver2pct);
-  EXPECT_LE(shared.stats.reference.maxRelativeError, own.stats.reference.maxRelativeError * 1.1);
+  EXPECT_LT(shared.stats.reference.fractionOver2pct * 2, own.stats.reference.fractionOver2pct);
+  EXPECT_LE(shared.stats.reference.maxRelativeError, own.stats.reference.maxRelativeError);
 }
 
 }  // namespace

@@ -153,7 +153,6 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
                               uint64_t& secondary, const ReconstructionTile* rt, AaCutCache* cache,
                               const Color& centre) {
   SubSampleSums sums;
-  if (cache) cache->pixel.count = 0;  // the samples its sub-samples record are its own
   Rng rng(o.seed, aaStream(x, y, o.width, o.height));
   const scene::Camera& cam = scene.camera();
   const int n = g * g - 1;

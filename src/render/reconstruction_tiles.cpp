@@ -28,7 +28,7 @@ void CellCuts::reset() {
 void AaCutCache::reset() {
   for (CellCuts& e : entries) e.reset();
   next = 0;
-  pixel.count = 0;
+  pixelSamples.count = pixelSamples.next = 0;
 }
 
 void AaCutCache::forget(const CutSample* s) {
@@ -410,9 +410,12 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
       for (int X = std::max(x0_, x - R); X <= std::min({x1_, x + R, o_.width - 1}); ++X)
         consider(scratch_.shared[slot(X, Y)], X * kSub + kSub / 2, Y * kSub + kSub / 2,
                  std::max(std::abs(X - x), std::abs(Y - y)), far2);
-    PixelSamples& own = cache.pixel;
+    PixelSamples& own = cache.pixelSamples;
     const float ownReach = kPixelSampleMaxFootprints * pixelAngle_ * length(hit.p - cam.eye);
-    for (int i = 0; i < own.count; ++i) consider(&own.slot[i], own.px[i], own.py[i], 0, ownReach * ownReach);
+    for (int i = 0; i < own.count; ++i) {
+      const int pixels = std::max(std::abs(own.px[i] / kSub - x), std::abs(own.py[i] / kSub - y));
+      if (pixels <= 1) consider(&own.slot[i], own.px[i], own.py[i], pixels, ownReach * ownReach);
+    }
     // Distinct, in image order (one set, one order: its merged cuts are cached).
     int order[4], n = 0;
     for (int q = 0; q < 4; ++q) {
@@ -461,14 +464,16 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
         if (r_.scene.occluded(a, d / len, len)) hook.count = 0;
       }
     }
-    // A full cut: recorded as one of the pixel's samples while there is room.
-    if (hook.count == 0 && o_.aaPixelSamples && own.count < PixelSamples::kMax) {
-      CutSample* s = &own.slot[own.count];
+    // A full cut: recorded as a pixel sample (over the oldest, once all kMax are taken).
+    if (hook.count == 0 && o_.aaPixelSamples) {
+      const int i = own.next;
+      own.next = (own.next + 1) % PixelSamples::kMax;
+      own.count = std::max(own.count, own.next == 0 ? PixelSamples::kMax : own.next);
+      CutSample* s = &own.slot[i];
       cache.forget(s);
       s->cut.clear();
-      own.px[own.count] = hook.px;
-      own.py[own.count] = hook.py;
-      ++own.count;
+      own.px[i] = hook.px;
+      own.py[i] = hook.py;
       hook.record = s;
       hook.recordFallback = true;
     }

@@ -120,37 +120,41 @@ struct CellCuts {
   void reset();
 };
 
-// Samples inside one antialiased pixel (RenderOptions::aaPixelSamples): the full cuts its
+// Samples inside antialiased pixels (RenderOptions::aaPixelSamples): the full cuts that
 // sub-samples took where no sample could serve them (beyond their samples near a surface,
 // cut off from them, or none near), each recorded as a sample at the sub-sample's position
-// for the pixel's later sub-samples, in their fixed order (so the image depends on nothing
-// else). Where one sub-sample on a crease or along a board's side face needs a full cut,
-// its neighbours in the pixel mostly do too; with it as a sample they lie near one, and
-// borrow. Samples gather where the image needs them, as cells split (Walter et al. 2005,
-// sec. 5). A pixel sample serves sub-samples within kPixelSampleMaxFootprints of it (a
-// face seen edge on spreads a pixel far across the world), and a sub-sample that uses one
-// and lies beyond its samples probes for a surface near it from kPixelSampleMinFootprints
-// on, not kExtrapolationMinFootprints: a surface was near enough for a full cut where the
-// pixel sample is, and hard shadows there change within a fraction of a pixel (an unseen
-// fence seen edge on: 0.5 footprints put 1.42% of pixels over 2%, 0.25 0.45%, against
-// 1.13% without pixel samples; docs/LIGHTCUTS.md, "Samples inside a pixel").
+// for the sub-samples after it in its pixel and in the next pixels of the tile (within one
+// pixel of it). Pixels and their sub-samples run in a fixed order within a tile and the
+// samples are dropped when a tile starts, so the image depends on nothing else (not on the
+// thread count). Where one sub-sample on a crease or along a board's side face needs a full
+// cut, its neighbours mostly do too; with it as a sample they lie near one, and borrow.
+// Samples gather where the image needs them, as cells split (Walter et al. 2005, sec. 5).
+// A pixel sample serves sub-samples within kPixelSampleMaxFootprints of it (a face seen
+// edge on spreads a pixel far across the world), and a sub-sample that uses one and lies
+// beyond its samples probes for a surface near it from kPixelSampleMinFootprints on, not
+// kExtrapolationMinFootprints: a surface was near enough for a full cut where the pixel
+// sample is, and hard shadows there change within a fraction of a pixel (an unseen fence
+// seen edge on, samples kept within their pixel: 0.5 footprints put 1.42% of pixels over
+// 2%, 0.25 0.45%, against 1.13% without pixel samples; docs/LIGHTCUTS.md, "Samples inside
+// a pixel").
 constexpr float kPixelSampleMaxFootprints = 2.0f;
 constexpr float kPixelSampleMinFootprints = 0.25f;
 struct PixelSamples {
-  static constexpr int kMax = 8;
+  static constexpr int kMax = 32;  // the most recent ones, replaced in turn
   CutSample slot[kMax];
   int px[kMax] = {}, py[kMax] = {};  // their positions, in the hull test's sub-pixel units
-  int count = 0;
+  int count = 0;  // slots in use
+  int next = 0;   // the slot the next one takes
 };
 
 // The merged cuts of the last few sets of samples antialiasing's sub-samples borrowed from
 // (neighbouring sub-samples, and pixels, mostly borrow from the same ones), replaced in
-// turn; and the current pixel's own samples.
+// turn; and the tile's pixel samples.
 struct AaCutCache {
   static constexpr int kEntries = 8;
   CellCuts entries[kEntries];
   int next = 0;
-  PixelSamples pixel;
+  PixelSamples pixelSamples;
   void reset();
   CellCuts* find(const CutSample* const* set, int k);
   // Drops the merged cuts that use `s` (a pixel sample about to be recorded anew).
@@ -275,8 +279,8 @@ class ReconstructionTile {
   // sample, where it is one, win all four, and sub-samples on a contact line borrowed from
   // it alone: up to 13% off.) One beyond its samples (the neighbouring pixel's case) also
   // gets a full lightcut where a surface lies near it (surfaceNear). A sub-sample that gets
-  // a full lightcut becomes one of the pixel's own samples (PixelSamples, in `cache`) for
-  // the sub-samples after it. `chosen` holds the samples; the merged cuts come from `cache`.
+  // a full lightcut becomes a pixel sample (PixelSamples, in `cache`) for the sub-samples
+  // after it. `chosen` holds the samples; the merged cuts come from `cache`.
   void subSampleHook(const scene::Ray& ray, int x, int y, Vec2 u, PrimaryHook& hook, const CutSample** chosen,
                      AaCutCache& cache) const;
 

@@ -129,11 +129,11 @@ struct RenderOptions {
   // with 10M VPLs at 1920 x 1080 +42%: its creases' full cuts are deep).
   bool aaExtrapolationProbe = true;
   // Antialiasing under reconstruction cuts: a sub-sample that takes a full cut (no sample
-  // serves it) is recorded as a sample for the rest of its pixel's sub-samples (PixelSamples
-  // in reconstruction_tiles.h). On by default: where one sub-sample on a crease or a board's
-  // edge needs a full cut its neighbours mostly do too, and now borrow from it instead. The
-  // Cornell box's full cuts at sub-samples 14,512 -> 6,983 (shadow rays per point -8%), an
-  // unseen fence's pixels over 2% 1.08% -> 0.74%, the Roman hall's shadow rays -33%
+  // serves it) is recorded as a sample for the sub-samples after it in its pixel and the
+  // next pixels of its tile (PixelSamples in reconstruction_tiles.h). On by default: where
+  // one sub-sample on a crease or a board's edge needs a full cut its neighbours mostly do
+  // too, and now borrow from it instead. The Cornell box's full cuts at sub-samples 14,512
+  // -> PIXCB (shadow rays per point PIXCBR), an unseen fence's pixels over 2% 1.08% -> 0.36%
   // (docs/LIGHTCUTS.md, "Samples inside a pixel").
   bool aaPixelSamples = true;
   // Luminance floor of lightcuts' relative error criterion (ShadingPoint::errorFloor): a
