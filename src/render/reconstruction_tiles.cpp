@@ -342,9 +342,8 @@ void ReconstructionTile::cellPixels(int cx, int cy, int w, int h) {
 // Whether a surface lies near a sub-sample that borrows from samples it lies beyond
 // (kExtrapolationReach in reconstruction_tiles.h): the world distance from the hit to the
 // nearest segment between two samples (or to the sample, for one), and, when that is over
-// `gate` pixel footprints, short occlusion rays from the hit.
-bool ReconstructionTile::surfaceNear(const Hit& hit, const CutSample* const* chosen, int k, PrimaryHook& hook,
-                                     float gate) const {
+// kExtrapolationMinFootprints pixel footprints, short occlusion rays from the hit.
+bool ReconstructionTile::surfaceNear(const Hit& hit, const CutSample* const* chosen, int k, PrimaryHook& hook) const {
   float d2 = kInf;
   for (int i = 0; i < k; ++i)
     for (int j = i; j < k; ++j) {
@@ -355,7 +354,7 @@ bool ReconstructionTile::surfaceNear(const Hit& hit, const CutSample* const* cho
     }
   const float footprint = pixelAngle_ * length(hit.p - r_.scene.camera().eye);
   const float d = std::sqrt(d2);
-  if (!(d > gate * footprint)) return false;
+  if (!(d > kExtrapolationMinFootprints * footprint)) return false;
   const Vec3 o = hit.p + hit.ns * (kSeparationLift * r_.scene.epsilon());
   Vec3 u, v;
   orthonormalBasis(hit.ns, u, v);
@@ -438,11 +437,8 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
       ++k;
     }
     hook.count = k;
-    bool usesOwn = false;  // a pixel sample: a surface was near enough for a full cut there
-    for (int i = 0; i < k; ++i) usesOwn |= chosen[i] >= own.slot && chosen[i] < own.slot + PixelSamples::kMax;
     if (k > 0 && !insideSamples(hook, (1u << k) - 1)) {
-      const float gate = usesOwn ? kPixelSampleMinFootprints : kExtrapolationMinFootprints;
-      if (nearest > 1 || (o_.aaExtrapolationProbe && surfaceNear(hit, chosen, k, hook, gate))) hook.count = 0;
+      if (nearest > 1 || (o_.aaExtrapolationProbe && surfaceNear(hit, chosen, k, hook))) hook.count = 0;
     }
     // A sample on the sub-sample's surface but cut off from it by another surface (the
     // segment between them, lifted off the surface, is blocked: a screen's crossbar across
