@@ -28,7 +28,7 @@ void CellCuts::reset() {
 void AaCutCache::reset() {
   for (CellCuts& e : entries) e.reset();
   next = 0;
-  pixelSamples.count = pixelSamples.next = 0;
+  pixelSamples.recorded = 0;
 }
 
 void AaCutCache::forget(const CutSample* s) {
@@ -342,8 +342,9 @@ void ReconstructionTile::cellPixels(int cx, int cy, int w, int h) {
 // Whether a surface lies near a sub-sample that borrows from samples it lies beyond
 // (kExtrapolationReach in reconstruction_tiles.h): the world distance from the hit to the
 // nearest segment between two samples (or to the sample, for one), and, when that is over
-// kExtrapolationMinFootprints pixel footprints, short occlusion rays from the hit.
-bool ReconstructionTile::surfaceNear(const Hit& hit, const CutSample* const* chosen, int k, PrimaryHook& hook) const {
+// kExtrapolationMinFootprints of the hit's pixel `footprint`, short occlusion rays from it.
+bool ReconstructionTile::surfaceNear(const Hit& hit, float footprint, const CutSample* const* chosen, int k,
+                                     PrimaryHook& hook) const {
   float d2 = kInf;
   for (int i = 0; i < k; ++i)
     for (int j = i; j < k; ++j) {
@@ -352,7 +353,6 @@ bool ReconstructionTile::surfaceNear(const Hit& hit, const CutSample* const* cho
       const float t = ee > 0 ? std::clamp(dot(hit.p - a, e) / ee, 0.0f, 1.0f) : 0.0f;
       d2 = std::min(d2, length2(hit.p - (a + e * t)));
     }
-  const float footprint = pixelAngle_ * length(hit.p - r_.scene.camera().eye);
   const float d = std::sqrt(d2);
   if (!(d > kExtrapolationMinFootprints * footprint)) return false;
   const Vec3 o = hit.p + hit.ns * (kSeparationLift * r_.scene.epsilon());
@@ -409,9 +409,10 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
       for (int X = std::max(x0_, x - R); X <= std::min({x1_, x + R, o_.width - 1}); ++X)
         consider(scratch_.shared[slot(X, Y)], X * kSub + kSub / 2, Y * kSub + kSub / 2,
                  std::max(std::abs(X - x), std::abs(Y - y)), far2);
+    const float footprint = pixelAngle_ * length(hit.p - cam.eye);
     PixelSamples& own = cache.pixelSamples;
-    const float ownReach = kPixelSampleMaxFootprints * pixelAngle_ * length(hit.p - cam.eye);
-    for (int i = 0; i < own.count; ++i) {
+    const float ownReach = kPixelSampleMaxFootprints * footprint;
+    for (int i = 0; i < own.count(); ++i) {
       const int pixels = std::max(std::abs(own.px[i] / kSub - x), std::abs(own.py[i] / kSub - y));
       if (pixels <= 1) consider(&own.slot[i], own.px[i], own.py[i], pixels, ownReach * ownReach);
     }
@@ -438,7 +439,7 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
     }
     hook.count = k;
     if (k > 0 && !insideSamples(hook, (1u << k) - 1)) {
-      if (nearest > 1 || (o_.aaExtrapolationProbe && surfaceNear(hit, chosen, k, hook))) hook.count = 0;
+      if (nearest > 1 || (o_.aaExtrapolationProbe && surfaceNear(hit, footprint, chosen, k, hook))) hook.count = 0;
     }
     // A sample on the sub-sample's surface but cut off from it by another surface (the
     // segment between them, lifted off the surface, is blocked: a screen's crossbar across
@@ -462,9 +463,7 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
     }
     // A full cut: recorded as a pixel sample (over the oldest, once all kMax are taken).
     if (hook.count == 0 && o_.aaPixelSamples) {
-      const int i = own.next;
-      own.next = (own.next + 1) % PixelSamples::kMax;
-      own.count = std::max(own.count, own.next == 0 ? PixelSamples::kMax : own.next);
+      const int i = own.recorded++ % PixelSamples::kMax;
       CutSample* s = &own.slot[i];
       cache.forget(s);
       s->cut.clear();

@@ -5,6 +5,7 @@
 // named interface, CutReconstruction.
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <optional>
@@ -143,8 +144,8 @@ struct PixelSamples {
   static constexpr int kMax = 32;  // the most recent ones, replaced in turn
   CutSample slot[kMax];
   int px[kMax] = {}, py[kMax] = {};  // their positions, in the hull test's sub-pixel units
-  int count = 0;  // slots in use
-  int next = 0;   // the slot the next one takes
+  int recorded = 0;  // since the tile started: the next takes slot recorded % kMax
+  int count() const { return std::min(recorded, kMax); }
 };
 
 // The merged cuts of the last few sets of samples antialiasing's sub-samples borrowed from
@@ -289,7 +290,8 @@ class ReconstructionTile {
   const CutSample& sample(int x, int y);
   std::optional<float> cornersDisagreement(const CutSample* const* corners, int n);
   bool probe(int x, int y, int& shape, Vec3& p, Vec3& n) const;
-  bool surfaceNear(const scene::Hit& hit, const CutSample* const* chosen, int k, PrimaryHook& hook) const;
+  bool surfaceNear(const scene::Hit& hit, float footprint, const CutSample* const* chosen, int k,
+                   PrimaryHook& hook) const;
   void cellPixels(int cx, int cy, int w, int h);
 
   ReconstructionRender& r_;
