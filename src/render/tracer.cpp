@@ -38,23 +38,25 @@ void pixelSamplePositions(int spp, Rng& rng, std::vector<Vec2>& out) {
 Color ShadowRays::operator()(const Vec3& wi, float dist) {
   return timed([&] {
     float tmax;
-    Vec3 o = origin(wi, dist, tmax);
+    Vec3 dir;
+    Vec3 o = origin(wi, dist, tmax, dir);
     if (!(tmax > 0)) return Color(1);
-    return scene_.transmittance(o, wi, tmax);
+    return scene_.transmittance(o, dir, tmax);
   });
 }
 
 Color ShadowRays::trace(const Vec3& wi, float dist, int& blocker, float& tHit) {
   return timed([&] {
     float tmax;
-    Vec3 o = origin(wi, dist, tmax);
+    Vec3 dir;
+    Vec3 o = origin(wi, dist, tmax, dir);
     blocker = kVisible;
     tHit = 0;
     if (!(tmax > 0)) return Color(1);
-    int shape = scene_.firstHit(o, wi, tmax, tHit);
+    int shape = scene_.firstHit(o, dir, tmax, tHit);
     if (shape < 0) return Color(1);
     if (scene_.isTransmissive(shape)) {  // glass on the way: the walk through it decides
-      Color v = scene_.transmittance(o, wi, tmax);
+      Color v = scene_.transmittance(o, dir, tmax);
       blocker = isBlack(v) ? kUnknownBlocker : kVisible;
       return v;
     }
@@ -64,24 +66,38 @@ Color ShadowRays::trace(const Vec3& wi, float dist, int& blocker, float& tHit) {
 }
 
 // Rays toward a box in front of the point's surface leave from p' = p + ng eps (and a step
-// along the ray) and end 2 eps short of the light moved by ng eps (origin()): each is part
-// of the segment from p' toward a point of the moved box, ending 2 eps before it. The
-// convex shape the point lies on (hit from outside) is behind its tangent plane, which the
-// box is in front of: no ray re-enters it.
+// along the ray) and end 2 eps short of the light (origin()): each is part of the segment
+// from p' toward a point of the box, ending 2 eps before it. The convex shape the point
+// lies on (hit from outside) is behind its tangent plane, which the box is in front of: no
+// ray re-enters it.
 bool ShadowRays::boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) {
   const Vec3 c = (lo + hi) * 0.5f, h = (hi - lo) * 0.5f;
   if (!scene_.occluders().built() || !(dot(ng_, c - p_) - dot(vabs(ng_), h) > 2 * eps_)) return false;
-  const Vec3 off = ng_ * eps_;
-  return scene_.occluders().clear(p_ + off, lo + off, hi + off, 0.1f * eps_, 2 * eps_, ownShape_, &hint);
+  return scene_.occluders().clear(p_ + ng_ * eps_, lo, hi, 0.1f * eps_, 2 * eps_, ownShape_, &hint);
 }
 
-// The ray's origin, off the surface on the light's side and a step toward the light,
-// and its length to just short of the light. The step matters on an edge where two
-// surfaces meet (a room's corner): the point lies in the other surface's plane, and
-// watertight hits (issue 29) would count that surface at t = 0 and shadow the edge.
-Vec3 ShadowRays::origin(const Vec3& wi, float dist, float& tmax) const {
-  tmax = std::isinf(dist) ? kInf : dist - 3 * eps_;
-  return p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_) + wi * eps_;
+// The ray: from p' = p + ng eps, off the surface on the light's side, toward the light
+// itself (p + wi dist), a step along the way and ending 3 eps short of the light (2 eps
+// short counted from p'). The step matters on an edge where two surfaces meet (a room's
+// corner): the point lies in the other surface's plane, and watertight hits (issue 29)
+// would count that surface at t = 0 and shadow the edge. The ray aims at the light, not at
+// the light moved by ng eps as it did: a light on a surface that p's surface faces (a VPL
+// on a wall, seen from a box's side) was then moved behind its own surface where the ray
+// meets it at a slant (cos below about 1/3 there), and its ray hit that surface: the red
+// wall's VPLs were hidden from the Cornell box's tall block, in brute force and lightcuts
+// alike (docs/LIGHTCUTS.md, "Shadow rays that end behind their light").
+Vec3 ShadowRays::origin(const Vec3& wi, float dist, float& tmax, Vec3& dir) const {
+  const Vec3 start = p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_);
+  if (std::isinf(dist)) {
+    dir = wi;
+    tmax = kInf;
+    return start + wi * eps_;
+  }
+  const Vec3 d = p_ + wi * dist - start;
+  const float len = length(d);
+  dir = len > 0 ? d / len : wi;
+  tmax = len - 3 * eps_;
+  return start + dir * eps_;
 }
 
 template <class F>

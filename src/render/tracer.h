@@ -35,7 +35,7 @@ class ShadowRays final : public lightcuts::Visibility {
   bool boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) override;
 
  private:
-  Vec3 origin(const Vec3& wi, float dist, float& tmax) const;
+  Vec3 origin(const Vec3& wi, float dist, float& tmax, Vec3& dir) const;
   template <class F>
   Color timed(const F& f);
 

@@ -1,0 +1,72 @@
+// ShadowRays: where a shadow ray leaves its surface and where it stops short of its light.
+#include "render/tracer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "io/ray_parser.h"
+#include "scene/scene.h"
+
+namespace lc::render {
+namespace {
+
+// Two walls 1 apart facing each other (x = 0, lit side +x; x = 1, lit side -x), 20 units
+// tall and deep, each two triangles.
+std::unique_ptr<scene::Scene> facingWalls() {
+  return scene::Scene::build(io::parseRayString(R"(SBT-raytracer 1.0
+material = { name = white; diffuse = (0.5, 0.5, 0.5); }
+trimesh { material = white; points = ((0, -10, -10), (0, 10, -10), (0, 10, 10), (0, -10, 10));
+          faces = ((0, 1, 2), (0, 2, 3)); }
+trimesh { material = white; points = ((1, -10, -10), (1, -10, 10), (1, 10, 10), (1, 10, -10));
+          faces = ((0, 1, 2), (0, 2, 3)); }
+)",
+                                                "walls.ray", ""));
+}
+
+// A light that lies on the facing wall (a VPL: where its path hit) is visible from every
+// point of the other wall, whatever the slant. The ray used to aim at the light moved off
+// the point's own surface (by its normal times epsilon), which here is behind the facing
+// wall; ending 3 epsilon short along the ray brought it back in front only where the ray
+// met that wall steeply (cos above about 1/2), so lights seen at a slant were hidden, in
+// brute force as in lightcuts: the Cornell box's red wall lit none of the tall block's side.
+TEST(ShadowRays, ALightOnTheFacingSurfaceIsVisibleAtAnySlant) {
+  auto scene = facingWalls();
+  scene::Hit h;
+  ASSERT_TRUE(scene->intersect(scene::Ray{Vec3(0.5f, 0.3f, -0.2f), Vec3(-1, 0, 0)}, h));
+  ASSERT_NEAR(h.p.x, 0, 1e-6);
+  ShadowRays vis(*scene, h);
+  int hidden = 0, total = 0;
+  for (float y : {0.0f, 0.5f, 1.0f, 2.0f, 3.0f, 5.0f, 8.0f})
+    for (float z : {-3.0f, 0.0f, 4.0f}) {
+      const Vec3 light(1, y, z);
+      const Vec3 d = light - h.p;
+      const float dist = length(d);
+      ++total;
+      int blocker;
+      float tHit;
+      const bool seen = vis(d / dist, dist).x == 1;
+      const bool traced = vis.trace(d / dist, dist, blocker, tHit).x == 1;
+      EXPECT_EQ(seen, traced) << y << " " << z;
+      hidden += !seen;
+    }
+  EXPECT_EQ(hidden, 0) << "of " << total << " lights on the facing wall";
+}
+
+// And the other way: a light just behind the facing wall stays hidden, at any slant.
+TEST(ShadowRays, ALightBehindTheFacingSurfaceIsHidden) {
+  auto scene = facingWalls();
+  scene::Hit h;
+  ASSERT_TRUE(scene->intersect(scene::Ray{Vec3(0.5f, 0.3f, -0.2f), Vec3(-1, 0, 0)}, h));
+  ShadowRays vis(*scene, h);
+  for (float y : {0.0f, 1.0f, 3.0f, 8.0f}) {
+    const Vec3 light(1.05f, y, 0);
+    const Vec3 d = light - h.p;
+    const float dist = length(d);
+    EXPECT_EQ(vis(d / dist, dist).x, 0) << y;
+  }
+}
+
+}  // namespace
+}  // namespace lc::render
