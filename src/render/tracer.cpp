@@ -95,7 +95,12 @@ Vec3 ShadowRays::origin(const Vec3& wi, float dist, float& tmax, Vec3& dir) cons
   }
   const Vec3 d = p_ + wi * dist - start;
   const float len = length(d);
-  dir = len > 0 ? d / len : wi;
+  if (!(len > 0) || std::isinf(len)) {  // a light at p, or so far that |d|^2 overflows
+    dir = wi;
+    tmax = dist - 3 * eps_;
+    return start + wi * eps_;
+  }
+  dir = d / len;
   tmax = len - 3 * eps_;
   return start + dir * eps_;
 }

@@ -68,5 +68,17 @@ TEST(ShadowRays, ALightBehindTheFacingSurfaceIsHidden) {
   }
 }
 
+// Lights so far away that the squared distance overflows a float still get a ray along
+// their direction: one beyond the facing wall is hidden, one past its edge is seen.
+TEST(ShadowRays, FarLightsAreTracedAlongTheirDirection) {
+  auto scene = facingWalls();
+  scene::Hit h;
+  ASSERT_TRUE(scene->intersect(scene::Ray{Vec3(0.5f, 0.3f, -0.2f), Vec3(-1, 0, 0)}, h));
+  ShadowRays vis(*scene, h);
+  const float far = 1e25f;
+  EXPECT_EQ(vis(normalize(Vec3(1, 0.1f, 0)), far).x, 0);
+  EXPECT_EQ(vis(normalize(Vec3(0.02f, 1, 0)), far).x, 1);
+}
+
 }  // namespace
 }  // namespace lc::render
