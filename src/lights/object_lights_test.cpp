@@ -820,6 +820,23 @@ TEST(ObjectLights, EmissionIsRadianceTimesArea) {
   near(b.scene->shadingMaterial(h).kd, Color(0.5f, 0.5f, 0.5f), 1e-6);
 }
 
+// The centre pixel (through look_at) of a 33 x 33 brute-force render of `body` (a .ray
+// scene after its header) by the CLI, at the given --emission-density.
+Color brutePixelBelow(const std::string& body, int emissionDensity) {
+  std::string bin = lightcutsBinary();
+  EXPECT_TRUE(std::filesystem::exists(bin)) << "build the lightcuts target (" << bin << ")";
+  testing::TempDir dir;
+  std::string scene = dir.file("scene.ray"), out = dir.file("scene.exr");
+  std::ofstream(scene) << "SBT-raytracer 1.0\n" << body;
+  std::string cmd = "'" + bin + "' render '" + scene + "' -o '" + out + "' --width 33 --height 33 --method brute " +
+                    "--emission-density " + std::to_string(emissionDensity) + " --threads 2 -q > '" +
+                    dir.file("log.txt") + "' 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  io::Image img = io::readImage(out);
+  EXPECT_EQ(img.width, 33);
+  return img.width == 33 ? img.at(16, 16) : Color(-1);
+}
+
 // Closed form: a square emitter of half-side a and radiance Le, facing down at height h over
 // a diffuse plane (kd). The renderer's diffuse term is kd cos(theta_s) x I cos(theta_l) / d^2
 // per oriented light (no 1/pi; point_light colour units), and the lights sum to A Le, so the
@@ -854,18 +871,7 @@ TEST(ObjectLights, EmittingSquareOverAPlaneMatchesTheClosedForm) {
   }
   EXPECT_NEAR(sum, want, 0.005 * want);
 
-  std::string bin = lightcutsBinary();
-  ASSERT_TRUE(std::filesystem::exists(bin)) << "build the lightcuts target (" << bin << ")";
-  testing::TempDir dir;
-  std::string scene = dir.file("square.ray"), out = dir.file("square.exr");
-  std::ofstream(scene) << "SBT-raytracer 1.0\n" << body;
-  std::string cmd = "'" + bin + "' render '" + scene + "' -o '" + out +
-                    "' --width 33 --height 33 --method brute --emission-density 400 --threads 2 -q > '" +
-                    dir.file("log.txt") + "' 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  io::Image img = io::readImage(out);
-  ASSERT_EQ(img.width, 33);
-  Color c = img.at(16, 16);  // the pixel through look_at: the plane right below the emitter
+  const Color c = brutePixelBelow(body, 400);  // the plane right below the emitter
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], want, 0.01 * want) << k;
   std::printf("closed form %.5f, lights %.5f, brute render %.5f\n", want, sum, double(c.y));
 }
@@ -884,18 +890,7 @@ TEST(ObjectLights, EmittingSphereOverAPlaneMatchesTheClosedForm) {
       "trimesh { material = { diffuse = (0.5, 0.5, 0.5); };"
       " points = ((-10,-10,0), (10,-10,0), (10,10,0), (-10,10,0)); faces = ((0,1,2), (0,2,3)); }\n"
       "translate(0, 0, 2, sphere_light { emission = (3, 3, 3); radius = 0.5; })\n";
-  std::string bin = lightcutsBinary();
-  ASSERT_TRUE(std::filesystem::exists(bin)) << "build the lightcuts target (" << bin << ")";
-  testing::TempDir dir;
-  std::string scene = dir.file("sphere.ray"), out = dir.file("sphere.exr");
-  std::ofstream(scene) << "SBT-raytracer 1.0\n" << body;
-  std::string cmd = "'" + bin + "' render '" + scene + "' -o '" + out +
-                    "' --width 33 --height 33 --method brute --emission-density 2000 --threads 2 -q > '" +
-                    dir.file("log.txt") + "' 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  io::Image img = io::readImage(out);
-  ASSERT_EQ(img.width, 33);
-  Color c = img.at(16, 16);  // the plane right below the sphere
+  const Color c = brutePixelBelow(body, 2000);  // the plane right below the emitter
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], want, 0.02 * want) << k;
   std::printf("closed form %.5f, brute render %.5f\n", want, double(c.y));
 }
