@@ -77,15 +77,16 @@ bool ShadowRays::boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) {
 }
 
 // The ray: from p' = p + ng eps, off the surface on the light's side, toward the light
-// itself (p + wi dist), a step along the way and ending 3 eps short of the light (2 eps
-// short counted from p'). The step matters on an edge where two surfaces meet (a room's
-// corner): the point lies in the other surface's plane, and watertight hits (issue 29)
-// would count that surface at t = 0 and shadow the edge. The ray aims at the light, not at
-// the light moved by ng eps as it did: a light on a surface that p's surface faces (a VPL
-// on a wall, seen from a box's side) was then moved behind its own surface where the ray
-// meets it at a slant (cos below about 1/3 there), and its ray hit that surface: the red
-// wall's VPLs were hidden from the Cornell box's tall block, in brute force and lightcuts
-// alike (docs/LIGHTCUTS.md, "Shadow rays that end behind their light").
+// itself (p + wi dist); it starts a step of eps along the way and ends 2 eps short of the
+// light. The step matters on an edge where two surfaces meet (a room's corner): the point
+// lies in the other surface's plane, and watertight hits (issue 29) would count that
+// surface at t = 0 and shadow the edge. The ray aims at the light, not at the light moved
+// by ng eps as it did: for a light on a surface that p's surface faces (a VPL on a wall
+// seen from a box's side, a ceiling panel seen from the floor) that end lay behind the
+// light's surface wherever the ray met it at a slant (cos below half of -ng . n_light, up
+// to 1/2), and the ray hit that surface: the red wall's VPLs were hidden from the Cornell
+// box's tall block, in brute force and lightcuts alike (docs/LIGHTCUTS.md, "Shadow rays
+// that end behind their light").
 Vec3 ShadowRays::origin(const Vec3& wi, float dist, float& tmax, Vec3& dir) const {
   const Vec3 start = p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_);
   if (std::isinf(dist)) {
