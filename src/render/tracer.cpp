@@ -88,13 +88,14 @@ bool ShadowRays::boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) {
 // box's tall block, in brute force and lightcuts alike (docs/LIGHTCUTS.md, "Shadow rays
 // that end behind their light").
 Vec3 ShadowRays::origin(const Vec3& wi, float dist, float& tmax, Vec3& dir) const {
-  const Vec3 start = p_ + ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_);
+  const Vec3 lift = ng_ * (dot(wi, ng_) >= 0 ? eps_ : -eps_);
+  const Vec3 start = p_ + lift;
   if (std::isinf(dist)) {
     dir = wi;
     tmax = kInf;
     return start + wi * eps_;
   }
-  const Vec3 d = p_ + wi * dist - start;
+  const Vec3 d = wi * dist - lift;  // (p + wi dist) - p', without adding and subtracting p
   const float len = length(d);
   if (!(len > 0) || std::isinf(len)) {  // a light at p, or so far that |d|^2 overflows
     dir = wi;
