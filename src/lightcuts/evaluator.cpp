@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "lightcuts/bounds.h"
+#include "lightcuts/exact_sum.h"
 
 namespace lc::lightcuts {
 
@@ -104,19 +105,9 @@ constexpr uint32_t kClearMinLights = 16;
 constexpr uint32_t kClearGraceFailures = 48;
 constexpr uint32_t kClearFailuresPerSuccess = 8;
 
-// Clusters of at most this many lights that end in a cut without a first-order estimate
-// and without a lower bound (across a surface's horizon, where the clamped cosine is not
-// smooth, or outside a spot's cone) are estimated by their exact unshadowed sum (a walk
-// over their lights, no rays) times one visibility. The representative alone is a
-// 0-or-everything sample there, and a tree's fixed representative errs the same way over
-// a whole surface: the white furnace's error for environment clusters at the default
-// --error; on a post's face beside lights above a lattice (accuracy_test's pergola) +2% of
-// the face's light from clusters whose representative is in front and -0.7% from those
-// whose representative is behind, 1.9% of the image's pixels over 2% (docs/LIGHTCUTS.md).
-constexpr uint32_t kExactSumMaxLights = 64;
-
-// Such a cluster whose representative contributes nothing at the point (it faces away,
-// lies behind the surface's horizon or outside its cone: no shadow ray, "untested") keeps
+// A small cluster (kExactSumMaxLights, exact_sum.h) whose representative contributes
+// nothing at the point (it faces away, lies behind the surface's horizon or outside its
+// cone: no shadow ray, "untested") keeps
 // an estimate of 0 while the cut is refined, and ends with its exact unshadowed sum U
 // times one visibility: either way the truth and the estimate lie in [0, U], so U bounds
 // its error as its upper bound over the box does, and often far below it (half its lights
@@ -137,13 +128,6 @@ struct ShadowResult {
   CutVisibility found = CutVisibility::Untested;
   int blocker = Visibility::kVisible;
   float tHit = 0;
-};
-
-// A small cluster's exact unshadowed sum at a point, and where its brightest light is.
-struct ExactSum {
-  Color sum;
-  float brightest = 0, brightestDist = kInf;
-  Vec3 brightestDir;
 };
 
 // M * G * V of one light per unit intensity (one shadow ray when the rest is non-zero).
@@ -438,7 +422,7 @@ class Lightcuts final : public LightEvaluator {
         // Untested and small: its exact unshadowed sum bounds its error (kExactSumMaxLights
         // and below).
         top1.exact = int32_t(exacts.size());
-        exacts.push_back(unshadowedSum(forest_.trees[top1.tree], top1.node, sp));
+        exacts.push_back(unshadowedSum(lights_, forest_.trees[top1.tree], top1.node, sp));
         const float u = luminance(exacts.back().sum);
         if (u < top1.spread) {
           sumSq = std::max(0.0, sumSq - double(top1.spread) * top1.spread) + double(u) * u;
@@ -537,8 +521,8 @@ class Lightcuts final : public LightEvaluator {
         // A small cluster across the surface's horizon (no lower bound): its exact
         // unshadowed sum, times the visibility of its representative or, when that one is
         // behind the surface or outside its cone, of its brightest light.
-        Color exact = withVisibility(cn.exact >= 0 ? exacts[cn.exact] : unshadowedSum(ctree, cn.node, sp), vis,
-                                     stats, cn.shadow.found);
+        Color exact = withVisibility(cn.exact >= 0 ? exacts[cn.exact] : unshadowedSum(lights_, ctree, cn.node, sp),
+                                     vis, stats, cn.shadow.found == CutVisibility::Visible);
         float raw = luminance(cn.estimate), le = luminance(exact);
         total += exact;
         total -= cn.estimate;
@@ -585,49 +569,6 @@ class Lightcuts final : public LightEvaluator {
   Method method() const override { return Method::Lightcuts; }
 
  private:
-  // The unshadowed sum of a cluster's lights at sp (a walk over them, no rays), and its
-  // brightest light's direction.
-  ExactSum unshadowedSum(const LightTree& tree, NodeRef node, const ShadingPoint& sp) const {
-    static thread_local std::vector<NodeRef> stack;
-    stack.assign(1, node);
-    Vec3d sum;
-    ExactSum e;
-    while (!stack.empty()) {
-      const NodeRef r = stack.back();
-      stack.pop_back();
-      if (!isLeafRef(r)) {
-        stack.push_back(tree.nodes[r].left(r));
-        stack.push_back(tree.nodes[r].right(r));
-        continue;
-      }
-      Color mg;
-      Vec3 wi;
-      float dist;
-      const Light& l = lights_.lights[leafLight(r)];
-      if (!lightContribution(l, lights_.groups[l.group], sp, mg, wi, dist)) continue;
-      Color c = mg * leafIntensity(l);
-      sum += c;
-      if (luminance(c) > e.brightest) {
-        e.brightest = luminance(c);
-        e.brightestDir = wi;
-        e.brightestDist = dist;
-      }
-    }
-    e.sum = sum.toFloat();
-    return e;
-  }
-
-  // A cluster's unshadowed sum times a visibility: 1 when its representative was found
-  // visible (`found`), else (the representative is behind the surface or outside its cone
-  // and cast no ray) that of its brightest light, one shadow ray.
-  static Color withVisibility(const ExactSum& e, Visibility& vis, EvalStats& stats, CutVisibility found) {
-    if (found == CutVisibility::Visible || !(e.brightest > 0)) return e.sum;
-    ++stats.shadowRays;
-    Color v = vis(e.brightestDir, e.brightestDist);
-    stats.occludedRays += isBlack(v);
-    return e.sum * v;
-  }
-
   // Whether the whole cluster is provably hidden from sp: its representative's shadow ray
   // (`rep`) and those toward the corners of its bounding box all meet one convex opaque
   // object, nearer than the box. The directions whose ray meets a convex object within a

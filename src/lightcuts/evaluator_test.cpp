@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/rng.h"
 #include "lightcuts/bounds.h"
+#include "lightcuts/exact_sum.h"
 #include "test_lights.h"
 
 namespace lc::lightcuts {
@@ -189,23 +190,7 @@ TEST(Lightcuts, RefinesTheLargestBoundFirst) {
       // exact unshadowed sum as its bound (kExactSumMaxLights).
       if (isBlack(unit(ni)) && t.nodes[ni].lights() <= 64 && std::find(known.begin(), known.end(), ni) == known.end()) {
         known.push_back(ni);
-        Vec3d sum;
-        std::vector<NodeRef> stack{ni};
-        while (!stack.empty()) {
-          NodeRef r = stack.back();
-          stack.pop_back();
-          if (!isLeafRef(r)) {
-            stack.push_back(t.nodes[r].left(r));
-            stack.push_back(t.nodes[r].right(r));
-            continue;
-          }
-          Color mg;
-          Vec3 wi;
-          float d;
-          const Light& l = s.lights[leafLight(r)];
-          if (lightContribution(l, g, sp, mg, wi, d)) sum += mg * l.intensity;
-        }
-        const float u = luminance(sum.toFloat());
+        const float u = luminance(unshadowedSum(s, t, ni, sp).sum);
         if (u < b) {
           heap.push({u, ni});
           continue;
@@ -568,22 +553,7 @@ TEST(MixedGroups, ManyConesShareOneTreeAndStayWithinTheError) {
     const std::vector<NodeRef> all = t.preorderNodes();
     for (size_t k7 = 0; k7 < all.size(); k7 += 7) {
       const NodeRef ni = all[k7];
-      std::vector<NodeRef> stack{ni};
-      double sum = 0;
-      while (!stack.empty()) {
-        const NodeRef r = stack.back();
-        stack.pop_back();
-        if (!isLeafRef(r)) {
-          stack.push_back(t.nodes[r].left(r));
-          stack.push_back(t.nodes[r].right(r));
-          continue;
-        }
-        Color mg;
-        Vec3 wi;
-        float d;
-        const Light& l = s.lights[leafLight(r)];
-        if (lightContribution(l, s.groups[l.group], sp, mg, wi, d)) sum += luminance(mg * l.intensity);
-      }
+      const double sum = luminance(unshadowedSum(s, t, ni, sp).sum);
       Color lower;
       Color upper = clusterBounds(t.node(s, ni), t.type, t.bound, sp, fr, &lower, nullptr, &t.boundLow);
       EXPECT_GE(double(luminance(upper)), sum * (1 - 1e-5)) << "node " << ni;
