@@ -107,20 +107,20 @@ constexpr uint32_t kClearFailuresPerSuccess = 8;
 
 // A small cluster (kExactSumMaxLights, exact_sum.h) whose representative contributes
 // nothing at the point (it faces away, lies behind the surface's horizon or outside its
-// cone: no shadow ray, "untested") keeps
-// an estimate of 0 while the cut is refined, and ends with its exact unshadowed sum U
-// times one visibility: either way the truth and the estimate lie in [0, U], so U bounds
-// its error as its upper bound over the box does, and often far below it (half its lights
-// face away). When such a node comes to the top of the heap, U is computed (the same walk
-// the end would make, kept for it) and the node goes back with U as its bound and spread
-// instead of being refined. Along the luminous torus's silhouette, clusters of 2-4 lights
-// each held their whole upper bound; full cuts there send 30% fewer rays (docs/LIGHTCUTS.md,
-// "Clusters behind the horizon"). Only untested clusters: for a hidden representative the
-// estimate is 0 and the error one-sided, and U in place of the bound put an unseen patio
-// from 0.68% to 4.7% of pixels over 2% (the criterion's root-sum-square counts on errors of
-// mixed signs). Not in recorded cuts: a point between reconstruction samples estimates an
-// untested node by its representative, 0 (reconstruction.h), so the samples refine them as
-// before (left whole, they put 18% of the dense luminous object's pixels over 2% at 512²).
+// cone: no shadow ray, "untested") keeps an estimate of 0 while the cut is refined, and ends
+// with its exact unshadowed sum U times one visibility: either way the truth and the
+// estimate lie in [0, U], so U bounds its error as its upper bound over the box does, and
+// often far below it (half its lights face away). When such a node comes to the top of the
+// heap, U is computed (the walk the end would make, kept for it) and the node goes back with
+// U as its bound and spread instead of being refined. Along the luminous torus's silhouette,
+// clusters of 2-4 lights each held their whole upper bound; full cuts there send 30% fewer
+// rays (docs/LIGHTCUTS.md, "Clusters behind the horizon"). Only untested clusters: for a
+// hidden representative the estimate is 0 and the error one-sided, and U in place of the
+// bound put an unseen patio from 0.68% to 4.7% of pixels over 2% (the criterion's
+// root-sum-square counts on errors of mixed signs). Not in recorded cuts: a point between
+// reconstruction samples estimates an untested node by its representative, 0
+// (reconstruction.h), so the samples refine them as before (left whole, they put 18% of the
+// dense luminous object's pixels over 2% at 512²).
 
 // What a representative's shadow ray found (recorded for reconstruction cuts) and, when
 // asked for, what stopped it (for the visibility probes).
@@ -416,22 +416,21 @@ class Lightcuts final : public LightEvaluator {
         break;
       }
       heapPop(heap);
-      CutNode& top1 = nodes[uint32_t(top)];
-      if (!record && top1.shadow.found == CutVisibility::Untested && top1.exact < 0 &&
-          top1.lights <= kExactSumMaxLights && !top1.scaled) {
-        // Untested and small: its exact unshadowed sum bounds its error (kExactSumMaxLights
-        // and below).
-        top1.exact = int32_t(exacts.size());
-        exacts.push_back(unshadowedSum(lights_, forest_.trees[top1.tree], top1.node, sp));
+      CutNode& popped = nodes[uint32_t(top)];
+      if (!record && popped.shadow.found == CutVisibility::Untested && popped.exact < 0 &&
+          popped.lights <= kExactSumMaxLights && !popped.scaled) {
+        // Untested and small: its exact unshadowed sum bounds its error (above).
+        popped.exact = int32_t(exacts.size());
+        exacts.push_back(unshadowedSum(lights_, forest_.trees[popped.tree], popped.node, sp));
         const float u = luminance(exacts.back().sum);
-        if (u < top1.spread) {
-          sumSq = std::max(0.0, sumSq - double(top1.spread) * top1.spread) + double(u) * u;
-          top1.spread = u;
+        if (u < popped.spread) {
+          sumSq = std::max(0.0, sumSq - double(popped.spread) * popped.spread) + double(u) * u;
+          popped.spread = u;
           heapPush(heap, heapKey(u, uint32_t(top)));
           continue;
         }
       }
-      const CutNode cn = top1;
+      const CutNode cn = popped;
       double& sum = cn.scaled ? sumScaled : sumSq;
       sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
       sumHideable = std::max(0.0, sumHideable - double(cn.hideable));
