@@ -418,7 +418,7 @@ class Lightcuts final : public LightEvaluator {
       heapPop(heap);
       CutNode& popped = nodes[uint32_t(top)];
       if (!record && popped.shadow.found == CutVisibility::Untested && popped.exact < 0 &&
-          popped.lights <= kExactSumMaxLights && !popped.scaled) {
+          popped.lights <= kExactSumMaxLights) {
         // Untested and small: its exact unshadowed sum bounds its error (above).
         popped.exact = int32_t(exacts.size());
         exacts.push_back(unshadowedSum(lights_, forest_.trees[popped.tree], popped.node, sp));

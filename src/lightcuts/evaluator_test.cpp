@@ -188,7 +188,7 @@ TEST(Lightcuts, RefinesTheLargestBoundFirst) {
       heap.pop();
       // A small cluster whose representative contributes nothing goes back once, with its
       // exact unshadowed sum as its bound (kExactSumMaxLights).
-      if (isBlack(unit(ni)) && t.nodes[ni].lights() <= 64 && std::find(known.begin(), known.end(), ni) == known.end()) {
+      if (isBlack(unit(ni)) && t.nodes[ni].lights() <= kExactSumMaxLights && std::find(known.begin(), known.end(), ni) == known.end()) {
         known.push_back(ni);
         const float u = luminance(unshadowedSum(s, t, ni, sp).sum);
         if (u < b) {
