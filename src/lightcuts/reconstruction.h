@@ -87,6 +87,7 @@ struct MergedCut {
     NodeRef node;
   };
   std::vector<Node> nodes;  // without the nodes every sample found occluded
+  std::vector<uint32_t> rayNodes;  // the indices in `nodes` of those not batched, in order
   uint32_t occluded = 0;    // how many those were (they are in the cut, contributing 0)
   MergedBatch batch;        // the batched nodes again, four lanes at a time
   // The batched nodes in groups of kGroupSize, in batch order (neighbours in the tree:
@@ -108,6 +109,7 @@ struct MergedCut {
   std::vector<float> hiddenScale;     // per group: its intensity over its probe's (luminance)
   void clear() {
     nodes.clear();
+    rayNodes.clear();
     occluded = 0;
     batch.clear();
     batchNodes.clear();
