@@ -171,7 +171,9 @@ TEST(FirstOrderUnit, DirectionalClusterAboveTheHorizonIsExactForDiffuse) {
       repErr += w * std::fabs(luminance(f) * wsum - truth) / truth;
       double fo = luminance(firstOrderUnit(rep, g, sp, m, f)) * wsum;
       foErr += w * std::fabs(fo - truth) / truth;
-      if (!specular) EXPECT_NEAR(fo, truth, 1e-4 * truth) << "config " << i;
+      if (!specular) {
+        EXPECT_NEAR(fo, truth, 1e-4 * truth) << "config " << i;
+      }
     }
     if (specular) {
       specRep += repErr;
