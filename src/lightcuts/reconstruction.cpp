@@ -276,10 +276,9 @@ bool probeContradicts(const Vec3& wi, float dist, bool samplesSaw, Visibility& v
 
 ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& cut, const ShadingPoint& sp,
                                        Visibility& vis, EvalStats& stats, float probeShare) {
-  // The nodes that need a ray, one by one; then the batched nodes four at a time, group
-  // by group.
-  // Their representatives' lights are fetched a few rays ahead: scattered over the light
-  // array, each was a cache miss.
+  // The nodes that need a ray, one by one (their representatives' lights fetched a few
+  // rays ahead: scattered over the light array, each was a cache miss); then the batched
+  // nodes four at a time, group by group.
   Color total(0);
   constexpr size_t kAhead = 4;
   const std::vector<uint32_t>& rays = cut.rayNodes;
