@@ -7,6 +7,8 @@
 
 #include <cstddef>
 #include <cstdlib>
+#include <cstring>
+#include <algorithm>
 #include <new>
 #include <type_traits>
 #include <utility>
@@ -18,15 +20,21 @@
 
 namespace lc {
 
-template <class T>
+// kUnwritten: resize() leaves new elements unwritten (below); false keeps std::vector's
+// value-initialisation (HugeVector).
+template <class T, bool kUnwritten = true>
 struct HugePageAllocator {
   using value_type = T;
   static constexpr size_t kHugePage = size_t(2) << 20;
   static constexpr size_t kThreshold = size_t(4) << 20;
+  template <class U>
+  struct rebind {
+    using other = HugePageAllocator<U, kUnwritten>;
+  };
 
   HugePageAllocator() noexcept = default;
   template <class U>
-  HugePageAllocator(const HugePageAllocator<U>&) noexcept {}
+  HugePageAllocator(const HugePageAllocator<U, kUnwritten>&) noexcept {}
 
   T* allocate(size_t n) {
     if (n > size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
@@ -55,27 +63,35 @@ struct HugePageAllocator {
   // 2.8 s, the page faults included, mostly serial). assign() and resize(n, value) are
   // unchanged.
   template <class U>
-  void construct(U* p) noexcept {
+  void construct(U* p) noexcept(kUnwritten) {
     static_assert(std::is_trivially_destructible_v<U>, "BigVector holds plain data");
-    (void)p;
+    if constexpr (kUnwritten)
+      (void)p;
+    else
+      ::new (static_cast<void*>(p)) U();
   }
   template <class U, class... Args>
   void construct(U* p, Args&&... args) {
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
   template <class U>
-  bool operator==(const HugePageAllocator<U>&) const noexcept { return true; }
+  bool operator==(const HugePageAllocator<U, kUnwritten>&) const noexcept { return true; }
 };
 
 // A std::vector whose large blocks sit on huge pages.
 template <class T>
 using BigVector = std::vector<T, HugePageAllocator<T>>;
+// The same with std::vector's value-initialisation kept (resize() writes T()), for arrays
+// that code outside the tree builders grows.
+template <class T>
+using HugeVector = std::vector<T, HugePageAllocator<T, false>>;
 
 // Switches a BigVector's block between huge and 4 KiB pages (advice only). The light tree's
 // layout fills its arrays in scattered order while it gives other large memory back: on
 // 4 KiB pages memory grows with what is written rather than by 2 MiB at each first touch;
-// afterwards the block is marked for huge pages again, for khugepaged. (Collapsing it back
-// at once, MADV_COLLAPSE, cost 1.7 s per 512 MB here, more than huge pages save.)
+// afterwards moveToHugePages puts them on huge pages. (Marked for huge pages again, the
+// block waited on khugepaged, which collapsed nothing before the render; MADV_COLLAPSE
+// cost 1.7 s per 512 MB here.)
 template <class T>
 void useHugePages(BigVector<T>& v, bool on) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE) && defined(MADV_NOHUGEPAGE)
@@ -87,6 +103,31 @@ void useHugePages(BigVector<T>& v, bool on) {
   (void)v;
   (void)on;
 #endif
+}
+
+// Moves a BigVector written on 4 KiB pages (useHugePages) onto a fresh block of huge
+// pages: copied 2 MiB at a time, each piece of the old block given back to the system as
+// soon as it is copied, so the memory in use grows by one piece, not by the array. The
+// elements are unchanged. (The cost is a copy and the new pages' faults; MADV_COLLAPSE, which
+// does the same in the kernel, took 1.7 s per 512 MB here.)
+template <class T>
+void moveToHugePages(BigVector<T>& v) {
+  static_assert(std::is_trivially_copyable_v<T>, "BigVector holds plain data");
+  constexpr size_t kPiece = HugePageAllocator<T>::kHugePage;
+  const size_t bytes = v.size() * sizeof(T);
+  if (bytes < HugePageAllocator<T>::kThreshold) return;
+  BigVector<T> moved;
+  moved.resize(v.size());  // unwritten: faulted in below, on huge pages
+  char* to = reinterpret_cast<char*>(moved.data());
+  char* from = reinterpret_cast<char*>(v.data());  // 2 MiB aligned (allocate)
+  for (size_t at = 0; at < bytes; at += kPiece) {
+    const size_t n = std::min(kPiece, bytes - at);
+    std::memcpy(to + at, from + at, n);
+#if defined(__linux__) && defined(MADV_DONTNEED)
+    madvise(from + at, n, MADV_DONTNEED);
+#endif
+  }
+  v.swap(moved);
 }
 
 }  // namespace lc

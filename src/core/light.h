@@ -23,6 +23,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "core/huge_pages.h"
 #include "core/math.h"
 
 namespace lc {
@@ -167,7 +168,9 @@ struct Light {
 // All lights of a scene plus the shared group table. Filled by the scene loader (point,
 // spot, directional), object lights and VPL generation; read by every light evaluator.
 struct LightSet {
-  std::vector<Light> lights;
+  // On huge pages when large (core/huge_pages.h): cuts read representatives at random over
+  // hundreds of megabytes at millions of lights.
+  HugeVector<Light> lights;
   std::vector<LightGroup> groups;
   static constexpr size_t kMaxGroups = 65535;  // Light::group is 16 bits
 

@@ -492,8 +492,10 @@ class TreeWriter {
     for (size_t k = 0; k < tasks.size(); ++k) known.emplace(tasks[k].slot, sums[k]);
     detail::subtreeMoments(cl_.lights, tree_, 0, &known);
     if (chunked) {
-      useHugePages(tree_.nodes, true);
-      useHugePages(tree_.moments, true);
+      // Cuts read the nodes at random: on 4 KiB pages a gigabyte of them is a TLB miss per
+      // read (khugepaged collapses a few megabytes a second).
+      moveToHugePages(tree_.nodes);
+      moveToHugePages(tree_.moments);
     }
   }
 

@@ -30,7 +30,7 @@ constexpr double kPiD = 3.14159265358979323846;
 struct Built {
   std::unique_ptr<Scene> scene;
   std::vector<ObjectLightInfo> info;
-  const std::vector<Light>& lights() const { return scene->lights().lights; }
+  const HugeVector<Light>& lights() const { return scene->lights().lights; }
 };
 
 io::SceneDesc parse(const std::string& body, const std::string& baseDir = "/base") {
@@ -58,7 +58,7 @@ std::string tri(const std::string& mat, const std::string& pts, const std::strin
   return "trimesh { " + mat + " points = " + pts + "; faces = ((0, 1, 2)); " + extra + " }\n";
 }
 
-double sum(const std::vector<Light>& ls, int c) {
+double sum(const HugeVector<Light>& ls, int c) {
   double s = 0;
   for (const Light& l : ls) s += l.intensity[c];
   return s;
@@ -732,7 +732,7 @@ TEST(ObjectLights, SameLightsAtAnyThreadCount) {
                            " points = ((0,0,0), (4,0,0), (4,4,1), (0,4,0), (2, 2, 3)); faces = ((0,1,2), (0,2,3), "
                            "(0, 1, 4), (1, 2, 4), (2, 3, 4)); }\n"
                            "scale(2, 1, 1, sphere { " + lum(5, 50) + " })\n";
-  std::vector<Light> one, many;
+  HugeVector<Light> one, many;
   {
     tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
     one = build(text).lights();

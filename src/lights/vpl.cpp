@@ -170,7 +170,7 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
   processBudget().reserve(reserved, fmt::format("{} VPLs", o.count));
 
   LightSet& set = scene.lights();
-  const std::vector<Light> sources = set.lights;  // VPLs are not sources themselves
+  const std::vector<Light> sources(set.lights.begin(), set.lights.end());  // VPLs are not sources themselves
   float radius = std::max(1e-6f, scene.bounds().diagonal() * 0.5f);
 
   EmissionSampler emission(scene, set, sources);
