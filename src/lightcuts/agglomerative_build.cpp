@@ -476,6 +476,11 @@ class TreeWriter {
       size_t to = from;
       while (to < tasks.size() && (!chunked || tasks[to].cluster < chunkBegin[c + 1])) ++to;
       tbb::parallel_for(size_t(from), to, [&](size_t k) {
+        // The subtree's inner nodes fill slots [slot, slot + lights - 1): their pages are
+        // faulted in at once rather than one trap at a time.
+        const size_t inner = cl_.count(tasks[k].cluster) - 1;
+        prefault(&tree_.nodes[tasks[k].slot], inner * sizeof(LightNode));
+        prefault(&tree_.moments[tasks[k].slot], inner * sizeof(NodeMoments));
         std::vector<LayoutItem> st{tasks[k]};
         while (!st.empty()) {
           LayoutItem it = st.back();

@@ -187,6 +187,11 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
   tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
     if (cancelled()) return;
     std::vector<Deposit>& dep = out[b];
+    // Room for a VPL per path, its pages faulted in with one call (core/huge_pages.h) rather
+    // than a trap each: grown from empty, the deposits were half the process's page faults
+    // at 10M paths (perf), each copied on the way.
+    dep.reserve(kBlock);
+    prefault(dep.data(), kBlock * sizeof(Deposit));
     for (size_t p = b * kBlock; p < std::min(n, (b + 1) * kBlock); ++p) {
       Rng rng(o.seed, p);
       EmissionSampler::Sample e = emission.sample(rng, n);
