@@ -498,7 +498,7 @@ class TreeWriter {
     detail::subtreeMoments(cl_.lights, tree_, 0, &known);
     if (chunked) {
       // Cuts read the nodes at random: on 4 KiB pages a gigabyte of them is a TLB miss per
-      // read (khugepaged collapses a few megabytes a second).
+      // read (khugepaged collapses under 2 MB a second by default).
       moveToHugePages(tree_.nodes);
       moveToHugePages(tree_.moments);
     }
