@@ -462,6 +462,7 @@ void reportRender(const RenderArgs& a, Cluster* cluster, const RenderSetup& s, c
   io::WriteOptions wo;
   wo.tonemap = a.tonemap;
   wo.exposure = a.exposure;
+  wo.threads = a.threads;  // the render's threads compress the EXR
   wo.metadata = metadata(a);
   wo.channels = aovChannels(s.aovs, scene, s.ro, rr);
   if (s.ext != "exr") {

@@ -7,6 +7,7 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
+#include <ImfThreading.h>
 #include <png.h>
 #include <stb_image.h>
 #include <stb_image_write.h>
@@ -29,7 +30,9 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "core/file_util.h"
@@ -80,7 +83,7 @@ std::vector<uint8_t> encodePpm(const Image& img, const std::vector<uint8_t>& rgb
 }
 
 void writeExr(const std::string& tmp, const std::string& path, const Image& img, const TextMetadata& metadata,
-              const std::vector<WriteOptions::Channel>& channels) {
+              const std::vector<WriteOptions::Channel>& channels, int threads) {
   // NaN -> 0 as in the 8-bit formats; infinities are kept (EXR can hold them).
   std::vector<Color> px(img.pixels);
   for (Color& c : px)
@@ -101,7 +104,15 @@ void writeExr(const std::string& tmp, const std::string& path, const Image& img,
     for (const WriteOptions::Channel& c : channels)
       fb.insert(c.name, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(c.values.data())),
                                    sizeof(float), sizeof(float) * size_t(img.width)));
-    Imf::OutputFile file(tmp.c_str(), header);
+    // The blocks are compressed on OpenEXR's global thread pool (without one, each is
+    // compressed inline, whatever the file's thread count).
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    {
+      static std::mutex poolMutex;
+      std::lock_guard<std::mutex> lock(poolMutex);
+      if (Imf::globalThreadCount() < threads) Imf::setGlobalThreadCount(threads);
+    }
+    Imf::OutputFile file(tmp.c_str(), header, threads);
     file.setFrameBuffer(fb);
     file.writePixels(img.height);
   } catch (const std::exception& e) {
@@ -716,7 +727,7 @@ void writeImage(const std::string& path, const Image& image, const WriteOptions&
   }
   if (ext == "exr") {
     writeFileAtomically(path,
-                        [&](const std::string& tmp) { writeExr(tmp, path, image, options.metadata, options.channels); });
+                        [&](const std::string& tmp) { writeExr(tmp, path, image, options.metadata, options.channels, options.threads); });
     return;
   }
   // Encode in memory first so that file errors come from our own writes (with errno)

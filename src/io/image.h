@@ -58,6 +58,10 @@ struct WriteOptions {
     std::vector<float> values;
   };
   std::vector<Channel> channels;
+  // EXR only: threads compressing its blocks of lines (0: one per core). The file's bytes
+  // are the same for any count; one thread took 0.7 s for a 1920x1080 image, a fifth of a
+  // second of the summary's total that was spent after the render.
+  int threads = 0;
 };
 
 // Writes by extension: .png .ppm .bmp (8-bit) or .exr (float). Throws lc::Error

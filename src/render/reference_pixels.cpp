@@ -120,7 +120,10 @@ void measureReference(const scene::Scene& scene, const lightcuts::LightEvaluator
 
 double vplClampedFraction(const scene::Scene& scene, const RenderOptions& o, int points, uint64_t maxEvaluations) {
   const LightSet& ls = scene.lights();
+  // (reserved at once: grown push by push, the copies and page faults of 8.1M indices took
+  // 0.16 s of one thread after a 10M-path render)
   std::vector<uint32_t> vpls;
+  vpls.reserve(ls.lights.size());
   for (uint32_t i = 0; i < ls.lights.size(); ++i)
     if (ls.groups[ls.lights[i].group].isVpl) vpls.push_back(i);
   if (vpls.empty()) return 0;
