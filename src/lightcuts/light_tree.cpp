@@ -364,14 +364,52 @@ void computeDirectionCones(const LightSet& lights, LightTree& tree) {
   }
 }
 
+std::vector<LightGroupList> lightsByGroup(const LightSet& lights, size_t block) {
+  // (One map lookup per light, and lists grown one index at a time, took 0.4 s of one
+  // thread at 8.1M lights.)
+  const size_t n = lights.lights.size();
+  block = std::max<size_t>(block, 1);
+  const size_t blocks = (n + block - 1) / block;
+  std::vector<std::map<GroupKey, std::vector<uint32_t>>> parts(blocks);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+    auto& part = parts[b];
+    std::vector<uint32_t>* last = nullptr;  // the previous light's list: runs share one
+    GroupKey lastKey{};
+    for (size_t i = b * block; i < std::min(n, (b + 1) * block); ++i) {
+      const Light& l = lights.lights[i];
+      if (!(luminance(l.intensity) > 0)) continue;
+      const GroupKey k{l.type, l.group};
+      if (!last || k.type != lastKey.type || k.group != lastKey.group) {
+        last = &part[k];
+        lastKey = k;
+      }
+      last->push_back(uint32_t(i));
+    }
+  });
+  std::map<GroupKey, size_t> sizes;
+  for (const auto& part : parts)
+    for (const auto& [k, v] : part) sizes[k] += v.size();
+  std::vector<LightGroupList> out;
+  std::map<GroupKey, size_t> at;
+  for (const auto& [k, size] : sizes) {
+    at[k] = out.size();
+    out.push_back(LightGroupList{k.type, uint16_t(k.group), {}});
+    out.back().lights.reserve(size);
+  }
+  for (auto& part : parts) {
+    for (const auto& [k, v] : part) {
+      std::vector<uint32_t>& dst = out[at[k]].lights;
+      dst.insert(dst.end(), v.begin(), v.end());
+    }
+    std::map<GroupKey, std::vector<uint32_t>>().swap(part);  // freed as it is joined
+  }
+  return out;
+}
+
 LightForest buildLightForest(const LightSet& lights, const TreeBuildOptions& options) {
   auto t0 = std::chrono::steady_clock::now();
   std::map<GroupKey, std::vector<uint32_t>> groups;
-  for (size_t i = 0; i < lights.lights.size(); ++i) {
-    const Light& l = lights.lights[i];
-    if (!(luminance(l.intensity) > 0)) continue;
-    groups[GroupKey{l.type, l.group}].push_back(uint32_t(i));
-  }
+  for (LightGroupList& g : lightsByGroup(lights)) groups[GroupKey{g.type, g.group}] = std::move(g.lights);
   // A kind with more groups than kMaxGroupTrees shares one tree that mixes them (measured:
   // 30,000 point lights, each with its own attenuation, 2.5x faster than a tree each; cutting
   // the groups, sorted, into 16 trees with tighter envelopes was 10% faster there but left

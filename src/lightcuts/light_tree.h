@@ -224,6 +224,16 @@ inline float clusterMetric(float intensity, const Vec3& lo, const Vec3& hi, floa
   return m >= double(std::numeric_limits<float>::max()) ? std::numeric_limits<float>::max() : float(m);
 }
 
+// The lights with non-zero intensity of each (type, group), each list in index order and
+// the lists by (type, group): gathered `block` lights at a time in parallel, then joined
+// block after block (buildLightForest's first step; the same lists for any block size).
+struct LightGroupList {
+  LightType type;
+  uint16_t group;
+  std::vector<uint32_t> lights;
+};
+std::vector<LightGroupList> lightsByGroup(const LightSet& lights, size_t block = size_t(1) << 20);
+
 // Builders over a list of light indices of one type and group (used by buildLightForest).
 LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint32_t>& indices,
                                  LightType type, float coneWeight, uint64_t seed,

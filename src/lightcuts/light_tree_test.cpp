@@ -12,6 +12,7 @@
 #include <future>
 #include <memory>
 #include <thread>
+#include <map>
 #include <set>
 
 #include "core/rng.h"
@@ -159,6 +160,37 @@ TEST(TreeBuild, SkipsLightsWithoutIntensity) {
   set.lights[3].intensity = Color(0);
   LightForest f = buildLightForest(set);
   EXPECT_EQ(leafCount(f.trees[0], f.trees[0].root), 9u);
+}
+
+// The lists of lights by (type, group) are the same whatever the block size the parallel
+// gathering uses: runs of one group crossing blocks, groups absent from some blocks, dark
+// lights skipped; each list in index order, the lists by (type, group).
+TEST(TreeBuild, LightsByGroupIsTheSameForAnyBlockSize) {
+  LightSet set = randomLights(200, LightType::Omni, 3);
+  LightGroup g2;
+  g2.atten = Attenuation{1, 0, 0, kInf};
+  const uint16_t gi = set.groupFor(g2);
+  for (size_t i = 0; i < set.lights.size(); ++i) {
+    if (i % 7 < 3) set.lights[i].group = gi;  // runs of three
+    if (i % 11 == 5) set.lights[i].type = LightType::Oriented;
+    if (i % 13 == 4) set.lights[i].intensity = Color(0);
+  }
+  // What they must be: one pass in index order.
+  std::map<std::pair<int, int>, std::vector<uint32_t>> expect;
+  for (uint32_t i = 0; i < set.lights.size(); ++i)
+    if (luminance(set.lights[i].intensity) > 0)
+      expect[{int(set.lights[i].type), int(set.lights[i].group)}].push_back(i);
+  for (size_t block : {size_t(1), size_t(2), size_t(5), size_t(64), size_t(1) << 20}) {
+    std::vector<LightGroupList> got = lightsByGroup(set, block);
+    ASSERT_EQ(got.size(), expect.size()) << block;
+    size_t k = 0;
+    for (const auto& [key, list] : expect) {
+      EXPECT_EQ(int(got[k].type), key.first) << block;
+      EXPECT_EQ(int(got[k].group), key.second) << block;
+      EXPECT_EQ(got[k].lights, list) << block;
+      ++k;
+    }
+  }
 }
 
 // computeMoments as it was, serial: the reference for the parallel one.

@@ -29,6 +29,7 @@
 #include <malloc.h>
 #endif
 #include <fmt/format.h>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -245,10 +246,22 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
   Color sceneIntensity(0);
   for (const Light& l : sources) sceneIntensity += l.intensity;
 
-  set.lights.reserve(set.lights.size() + count);
-  Vec3d power;  // over millions of VPLs: in double
-  for (const auto& d : out)
-    for (const Deposit& v : d) {
+  // The lights in path order, written by blocks in parallel (one thread took 0.7 s for 8.1M
+  // of them at 10M paths, the light array's page faults included); the power summed per
+  // block, then over the blocks in order, so it does not depend on the thread count.
+  std::vector<size_t> first(blocks + 1, 0);
+  for (size_t b = 0; b < blocks; ++b) first[b + 1] = first[b] + out[b].size();
+  const size_t base = set.lights.size();
+  set.lights.reserve(base + count);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, count, size_t(1) << 18), [&](const tbb::blocked_range<size_t>& r) {
+    prefault(set.lights.data() + base + r.begin(), r.size() * sizeof(Light));
+  });
+  set.lights.resize(base + count);
+  std::vector<Vec3d> blockPower(blocks);
+  tbb::parallel_for(size_t(0), blocks, [&](size_t b) {
+    Light* dst = set.lights.data() + base + first[b];
+    Vec3d sum;  // over millions of VPLs: in double
+    for (const Deposit& v : out[b]) {
       Light l;
       l.type = LightType::Oriented;
       l.group = group;
@@ -256,10 +269,14 @@ VplInfo addVpls(scene::Scene& scene, const VplOptions& o) {
       l.direction = v.normal;
       Color I = o.normalize == VplNormalize::Object ? sceneIntensity * v.kd / float(perShape[size_t(v.shape)])
                                                     : v.flux / kPi;
-      power += o.normalize == VplNormalize::Object ? I * kPi : v.flux;
+      sum += o.normalize == VplNormalize::Object ? I * kPi : v.flux;
       l.intensity = I * scale;
-      set.lights.push_back(l);
+      *dst++ = l;
     }
+    blockPower[b] = sum;
+  });
+  Vec3d power;
+  for (const Vec3d& p : blockPower) power += p;
   // The deposits (52 bytes per VPL, in blocks of a thousand) go back to the system now: freed
   // blocks of that size stay in the allocator's per-thread arenas, where the light tree's
   // large arrays cannot reuse them (at 10M paths, 245 MB held through the tree build).
