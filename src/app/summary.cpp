@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <thread>
 
 #include "app/progress.h"
@@ -9,17 +10,29 @@
 
 namespace lc::app {
 
+namespace {
+// The lights of each type, in one pass (a pass per type read the 325 MB light array of a
+// 10M-path render four times over).
+std::array<size_t, kLightTypeCount> countsByType(const LightSet& ls) {
+  std::array<size_t, kLightTypeCount> n{};
+  for (const Light& l : ls.lights) ++n[size_t(l.type)];
+  return n;
+}
+}  // namespace
+
 nlohmann::json lightCountsJson(const LightSet& ls) {
   nlohmann::json j;
-  for (int t = 0; t < kLightTypeCount; ++t) j[lightTypeName(LightType(t))] = ls.countOf(LightType(t));
+  const auto counts = countsByType(ls);
+  for (int t = 0; t < kLightTypeCount; ++t) j[lightTypeName(LightType(t))] = counts[size_t(t)];
   j["total"] = ls.size();
   return j;
 }
 
 std::string lightCountsLine(const LightSet& ls) {
   std::string kinds;
+  const auto counts = countsByType(ls);
   for (int t = 0; t < kLightTypeCount; ++t)
-    if (size_t c = ls.countOf(LightType(t)))
+    if (size_t c = counts[size_t(t)])
       kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", c, lightTypeName(LightType(t)));
   return fmt::format("{}{}", ls.size(), kinds.empty() ? "" : " (" + kinds + ")");
 }

@@ -84,11 +84,19 @@ std::vector<uint8_t> encodePpm(const Image& img, const std::vector<uint8_t>& rgb
 
 void writeExr(const std::string& tmp, const std::string& path, const Image& img, const TextMetadata& metadata,
               const std::vector<WriteOptions::Channel>& channels, int threads) {
-  // NaN -> 0 as in the 8-bit formats; infinities are kept (EXR can hold them).
-  std::vector<Color> px(img.pixels);
-  for (Color& c : px)
-    for (int k = 0; k < 3; ++k)
-      if (std::isnan(c[k])) c[k] = 0;
+  // NaN -> 0 as in the 8-bit formats; infinities are kept (EXR can hold them). Copied only
+  // when there is a NaN to clear (25 MB at 1920x1080).
+  const bool hasNan = std::any_of(img.pixels.begin(), img.pixels.end(), [](const Color& c) {
+    return std::isnan(c.x) || std::isnan(c.y) || std::isnan(c.z);
+  });
+  std::vector<Color> cleared;
+  if (hasNan) {
+    cleared = img.pixels;
+    for (Color& c : cleared)
+      for (int k = 0; k < 3; ++k)
+        if (std::isnan(c[k])) c[k] = 0;
+  }
+  const std::vector<Color>& px = hasNan ? cleared : img.pixels;
   try {
     Imf::Header header(img.width, img.height);
     // 32-bit float channels: the round trip is exact (half would lose precision).
@@ -97,7 +105,7 @@ void writeExr(const std::string& tmp, const std::string& path, const Image& img,
     for (const WriteOptions::Channel& c : channels) header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
     Imf::FrameBuffer fb;
     const size_t xs = sizeof(Color), ys = sizeof(Color) * size_t(img.width);
-    char* base = reinterpret_cast<char*>(px.data());
+    char* base = reinterpret_cast<char*>(const_cast<Color*>(px.data()));  // read only
     fb.insert("R", Imf::Slice(Imf::FLOAT, base + offsetof(Color, x), xs, ys));
     fb.insert("G", Imf::Slice(Imf::FLOAT, base + offsetof(Color, y), xs, ys));
     fb.insert("B", Imf::Slice(Imf::FLOAT, base + offsetof(Color, z), xs, ys));
