@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <array>
 #include <thread>
 
 #include "app/progress.h"
@@ -10,19 +9,9 @@
 
 namespace lc::app {
 
-namespace {
-// The lights of each type, in one pass (a pass per type read the 325 MB light array of a
-// 10M-path render four times over).
-std::array<size_t, kLightTypeCount> countsByType(const LightSet& ls) {
-  std::array<size_t, kLightTypeCount> n{};
-  for (const Light& l : ls.lights) ++n[size_t(l.type)];
-  return n;
-}
-}  // namespace
-
 nlohmann::json lightCountsJson(const LightSet& ls) {
   nlohmann::json j;
-  const auto counts = countsByType(ls);
+  const auto counts = ls.countsByType();
   for (int t = 0; t < kLightTypeCount; ++t) j[lightTypeName(LightType(t))] = counts[size_t(t)];
   j["total"] = ls.size();
   return j;
@@ -30,7 +19,7 @@ nlohmann::json lightCountsJson(const LightSet& ls) {
 
 std::string lightCountsLine(const LightSet& ls) {
   std::string kinds;
-  const auto counts = countsByType(ls);
+  const auto counts = ls.countsByType();
   for (int t = 0; t < kLightTypeCount; ++t)
     if (size_t c = counts[size_t(t)])
       kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", c, lightTypeName(LightType(t)));

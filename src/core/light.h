@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <iterator>
@@ -195,11 +196,13 @@ struct LightSet {
     syncIndex();
     return groups.size() < kMaxGroups || index_.count(keyOf(g)) != 0;
   }
-  size_t countOf(LightType t) const {
-    size_t n = 0;
-    for (const Light& l : lights) n += l.type == t;
+  // The lights of each type, in one pass over the array (325 MB at 10M VPL paths).
+  std::array<size_t, kLightTypeCount> countsByType() const {
+    std::array<size_t, kLightTypeCount> n{};
+    for (const Light& l : lights) ++n[size_t(l.type)];
     return n;
   }
+  size_t countOf(LightType t) const { return countsByType()[size_t(t)]; }
   size_t size() const { return lights.size(); }
 
  private:
