@@ -14,33 +14,40 @@ namespace lc::lightcuts {
 
 namespace {
 
-// Sorts a cut's recorded entries (tree << 32 | CutRecord entry, and a factor) by key: by
-// tree, then preorder, unique per entry. For a cut of a thousand nodes std::sort was 4% of
-// the church's render (perf); a radix sort over the key's significant bits, the tree above
-// the preorder (the entry's 3 low bits are payload), takes two or three passes.
-void sortRecorded(std::vector<std::pair<uint64_t, float>>& v) {
+// A recorded cut node: tree << 32 | CutRecord entry, its first-order factor and its node.
+struct Recorded {
+  uint64_t key;
+  float factor;
+  NodeRef node;
+};
+
+// Sorts a cut's recorded entries by key: by tree, then preorder, unique per entry. For a cut
+// of a thousand nodes std::sort was 4% of the church's render (perf); a radix sort over the
+// key's significant bits, the tree above the preorder (the entry's 3 low bits are payload),
+// takes two or three passes.
+void sortRecorded(std::vector<Recorded>& v) {
   if (v.size() < 256) {
-    std::sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::sort(v.begin(), v.end(), [](const Recorded& a, const Recorded& b) { return a.key < b.key; });
     return;
   }
   uint32_t maxTree = 0, maxPre = 0;
-  for (const auto& e : v) {
-    maxTree = std::max(maxTree, uint32_t(e.first >> 32));
-    maxPre = std::max(maxPre, CutRecord::preorderOf(uint32_t(e.first)));
+  for (const Recorded& e : v) {
+    maxTree = std::max(maxTree, uint32_t(e.key >> 32));
+    maxPre = std::max(maxPre, CutRecord::preorderOf(uint32_t(e.key)));
   }
   const int preBits = std::bit_width(maxPre), bits = preBits + std::bit_width(maxTree);
   auto compact = [preBits](uint64_t k) { return (k >> 32) << preBits | CutRecord::preorderOf(uint32_t(k)); };
   constexpr int kDigit = 10;
   constexpr uint32_t kMask = (1u << kDigit) - 1;
-  static thread_local std::vector<std::pair<uint64_t, float>> tmp;
+  static thread_local std::vector<Recorded> tmp;
   tmp.resize(v.size());
   uint32_t count[1u << kDigit];
   for (int shift = 0; shift < bits; shift += kDigit) {
     std::fill(std::begin(count), std::end(count), 0u);
-    for (const auto& e : v) ++count[compact(e.first) >> shift & kMask];
+    for (const Recorded& e : v) ++count[compact(e.key) >> shift & kMask];
     uint32_t sum = 0;
     for (uint32_t& c : count) sum += std::exchange(c, sum);
-    for (const auto& e : v) tmp[count[compact(e.first) >> shift & kMask]++] = e;
+    for (const Recorded& e : v) tmp[count[compact(e.key) >> shift & kMask]++] = e;
     v.swap(tmp);
   }
 }
@@ -276,8 +283,7 @@ class Lightcuts final : public LightEvaluator {
 
   // The lightcut at sp; with `record`, its nodes are also written there.
   EvalResult cut(const ShadingPoint& sp, Visibility& vis, EvalStats& stats, CutRecord* record) const {
-    // tree << 32 | CutRecord entry, and the entry's first-order factor
-    static thread_local std::vector<std::pair<uint64_t, float>> recorded;
+    static thread_local std::vector<Recorded> recorded;
     recorded.clear();
     static thread_local std::vector<uint64_t> heap;
     static thread_local std::vector<CutNode> nodes;
@@ -310,8 +316,8 @@ class Lightcuts final : public LightEvaluator {
     Pushed pending[2], fresh[2];
     uint32_t pendingCount = 0, freshCount = 0;
     // Adds a node to the cut: its estimate to the total, and to the heap unless exact.
-    auto record1 = [&](uint32_t t, uint32_t pre, CutVisibility found, bool fo, float factor = 1) {
-      recorded.emplace_back(uint64_t(t) << 32 | CutRecord::pack(pre, found, fo), factor);
+    auto record1 = [&](uint32_t t, NodeRef ni, uint32_t pre, CutVisibility found, bool fo, float factor = 1) {
+      recorded.push_back(Recorded{uint64_t(t) << 32 | CutRecord::pack(pre, found, fo), factor, ni});
     };
     // Node ni, at preorder position pre.
     // clear: the node's parent was clear (Visibility::boxClear), and so is the node;
@@ -323,7 +329,7 @@ class Lightcuts final : public LightEvaluator {
       if (isLeafRef(ni)) {
         total += unit * leafIntensity(lights_.lights[leafLight(ni)]);
         ++cutSize;
-        if (record) record1(t, pre, found, false);
+        if (record) record1(t, ni, pre, found, false);
         return;
       }
       const LightNode& n = tree.nodes[ni];
@@ -375,7 +381,7 @@ class Lightcuts final : public LightEvaluator {
         nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, left, right, n.rep, n.lights(),
                                 pre, n.rightPre(pre), fo, scaled, clear, hideable, blocker, -1});
       } else if (record) {
-        record1(t, pre, found, false);
+        record1(t, ni, pre, found, false);
       }
     };
 
@@ -440,7 +446,7 @@ class Lightcuts final : public LightEvaluator {
         // Its representative is hidden, and so is the whole cluster: it stays in the cut,
         // exactly 0, instead of being refined down to its lights.
         ++stats.hiddenClusters;
-        if (record) record1(cn.tree, cn.pre, CutVisibility::Occluded, false);
+        if (record) record1(cn.tree, cn.node, cn.pre, CutVisibility::Occluded, false);
         continue;
       }
       total -= cn.estimate;
@@ -542,7 +548,7 @@ class Lightcuts final : public LightEvaluator {
           factor = std::clamp(kept / raw, 0.5f, 2.0f);
         }
       }
-      if (record) record1(cn.tree, cn.pre, cn.shadow.found, cn.firstOrder, factor);
+      if (record) record1(cn.tree, cn.node, cn.pre, cn.shadow.found, cn.firstOrder, factor);
     }
     if (record) {
       // The cut: the nodes left in the heap, and the exact ones recorded as they came.
@@ -552,11 +558,13 @@ class Lightcuts final : public LightEvaluator {
       record->point = sp.p;
       record->entries.resize(recorded.size());
       record->factor.resize(recorded.size());
+      record->nodes.resize(recorded.size());
       record->treeBegin.assign(forest_.trees.size() + 1, uint32_t(recorded.size()));
       for (size_t i = recorded.size(); i-- > 0;) {
-        record->entries[i] = uint32_t(recorded[i].first);
-        record->factor[i] = recorded[i].second;
-        record->treeBegin[recorded[i].first >> 32] = uint32_t(i);
+        record->entries[i] = uint32_t(recorded[i].key);
+        record->factor[i] = recorded[i].factor;
+        record->nodes[i] = recorded[i].node;
+        record->treeBegin[recorded[i].key >> 32] = uint32_t(i);
       }
       // Trees with no entries begin where the next one does.
       for (size_t t = forest_.trees.size(); t-- > 0;)

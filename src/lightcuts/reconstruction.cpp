@@ -46,17 +46,10 @@ inline float distance2Box(const LightNode& n, const Vec3& p) {
 constexpr uint8_t kFirstOrderBit = 4;
 constexpr uint8_t kStateMask = 7;  // visibility and kFirstOrderBit
 
-// A node of the walk with, per sample i, byte i of `state`: kAbove, or the CutVisibility it
-// inherits, with kFirstOrderBit when that cut node used its first-order estimate (then so
-// may every node below it: a part of a cluster over which the contribution is smooth is
-// smooth too). One 32-bit word, not a byte array: the walk keeps it in a register (as
-// bytes in memory, each push read back what it had just written byte by byte, a
-// store-forwarding stall that was a fifth of the merge, perf on the church).
-struct Item {
-  NodeRef node;
-  uint32_t pre;  // its preorder position
-  uint32_t state;
-};
+// Per sample i, byte i of a 32-bit word (kept in a register): kAbove while the sample's cut
+// lies below the current node, else the CutVisibility its cut node there has, with
+// kFirstOrderBit when that node used its first-order estimate (then so may every node below
+// it: a part of a cluster over which the contribution is smooth is smooth too).
 inline uint8_t stateOf(uint32_t state, int i) { return uint8_t(state >> (8 * i)); }
 inline void setState(uint32_t& state, int i, uint8_t v) {
   state = (state & ~(0xffu << (8 * i))) | uint32_t(v) << (8 * i);
@@ -64,11 +57,17 @@ inline void setState(uint32_t& state, int i, uint8_t v) {
 
 }  // namespace
 
+// The merge goes from entry to entry. Each sample's entries of a tree partition its lights,
+// in preorder, so the merged cut's nodes are entries too: at each place the finest of the
+// samples', which the coarser samples' entries there cover. A k-way merge over the entries
+// reads the tree only at them (their bounds, sums and sizes), never the nodes above them
+// that a walk from the root would pass through (about as many again: a fifth of the merge
+// at 8.1M lights was those nodes' cache misses, perf). Its result is that of the walk from
+// the root that it replaced, node for node.
 void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecord* const* samples, int count,
                MergedCut& out) {
   out.clear();
   count = std::clamp(count, 0, kMaxSamples);
-  static thread_local std::vector<Item> stack;
   // Per sample: how many of its entries before each one are not visible with a
   // first-order estimate, so that any run of entries can be checked at once.
   static thread_local std::vector<uint32_t> rough[kMaxSamples];
@@ -84,48 +83,81 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
   float spread2 = 0;
   for (int i = 0; i < count; ++i)
     for (int j = i + 1; j < count; ++j) spread2 = std::max(spread2, length2(samples[i]->point - samples[j]->point));
+  constexpr uint32_t kNone = ~0u;
   for (uint32_t t = 0; t < forest.trees.size(); ++t) {
     const LightTree& tree = forest.trees[t];
     if (tree.empty()) continue;
-    // Each sample's entries of this tree are in preorder, and so is the walk: one cursor
-    // per sample moves forward only.
+    // Per sample: the next entry not yet taken, and the end of its tree's entries.
     uint32_t cursor[kMaxSamples], end[kMaxSamples];
+    // Per sample with a state (not kAbove): the preorder position where the entry that gave
+    // it ends (the first past its subtree).
+    uint32_t coverEnd[kMaxSamples];
     for (int i = 0; i < count; ++i) {
       cursor[i] = samples[i]->treeBegin[t];
       end[i] = samples[i]->treeBegin[t + 1];
+      coverEnd[i] = 0;
     }
-    stack.clear();
-    Item it{tree.root, 0, 0xffffffffu};  // the root, kAbove for every sample
-    bool descending = true;   // `it` is the left child just reached, not yet on the stack
-    for (;;) {
-      if (!descending) {
-        if (stack.empty()) break;
-        it = stack.back();
-        stack.pop_back();
-      }
-      descending = false;
-      // Bit i: sample i's cut holds this very node (its entry is the one before its cursor).
-      uint32_t exact = 0;
-      const bool leaf = isLeafRef(it.node);
-      const LightNode n = tree.node(lights, it.node);
-      const uint32_t pre = it.pre;
-      bool above = false;
+    uint32_t state = 0xffffffffu;  // kAbove for every sample
+    const uint32_t treeEnd = 2 * tree.lightCount(tree.root) - 1;  // the preorder positions
+    constexpr uint32_t kAhead = 4;  // entries whose nodes are fetched ahead, per sample
+    for (uint32_t pos = 0; pos < treeEnd;) {
+      // The node at `pos` is that of the samples whose next entry starts there (`exact`);
+      // samples whose next entry starts further on are finer here (`above`).
+      NodeRef node = pos == 0 ? tree.root : kNone;
+      uint32_t exact = 0, exactAt[kMaxSamples], next = kNone;
       for (int i = 0; i < count; ++i) {
-        if (stateOf(it.state, i) != kAbove) continue;
+        if (stateOf(state, i) != kAbove) {
+          if (coverEnd[i] > pos) continue;
+          setState(state, i, kAbove);
+        }
         const uint32_t* e = samples[i]->entries.data();
         uint32_t c = cursor[i];
-        while (c < end[i] && CutRecord::preorderOf(e[c]) < pre) ++c;  // skips nodes of subtrees not walked
-        if (c < end[i] && CutRecord::preorderOf(e[c]) == pre) {
-          setState(it.state, i, uint8_t(uint8_t(CutRecord::visibilityOf(e[c])) |
-                                        (CutRecord::firstOrderOf(e[c]) ? kFirstOrderBit : 0)));
+        while (c < end[i] && CutRecord::preorderOf(e[c]) < pos) ++c;  // skips entries under a coarser cut kept
+        cursor[i] = c;
+        if (c >= end[i]) {
+          setState(state, i, uint8_t(CutVisibility::Untested));  // a record of another forest
+          coverEnd[i] = kNone;
+          continue;
+        }
+        const uint32_t p = CutRecord::preorderOf(e[c]);
+        if (p == pos) {
+          // The node a few entries on, fetched by the first sample that holds this one
+          // (the samples' cuts are mostly the same nodes).
+          if (exact == 0 && c + kAhead < end[i]) {
+            const NodeRef ahead = samples[i]->nodes[c + kAhead];
+            __builtin_prefetch(isLeafRef(ahead) ? static_cast<const void*>(&lights.lights[leafLight(ahead)])
+                                                : static_cast<const void*>(&tree.nodes[ahead]));
+          }
+          node = samples[i]->nodes[c];
+          setState(state, i, uint8_t(uint8_t(CutRecord::visibilityOf(e[c])) |
+                                     (CutRecord::firstOrderOf(e[c]) ? kFirstOrderBit : 0)));
           exact |= 1u << i;
-          ++c;
-        } else if (leaf || c >= end[i]) {
-          setState(it.state, i, uint8_t(CutVisibility::Untested));  // a record of another forest
+          exactAt[i] = c;
+          cursor[i] = c + 1;
+        } else {
+          next = std::min(next, p);
+        }
+      }
+      if (node == kNone) {
+        // No sample's entry starts here: the samples that are finer go on at their next
+        // entry (the nodes between are ones no sample kept); if none is, the records do
+        // not cover the tree.
+        if (next == kNone) break;
+        pos = next;
+        continue;
+      }
+      const LightNode n = tree.node(lights, node);
+      const bool leaf = isLeafRef(node);
+      const uint32_t nodeEnd = leaf ? pos + 1 : pos + 2 * n.lights() - 1;
+      bool above = false;
+      for (int i = 0; i < count; ++i) {
+        if (stateOf(state, i) != kAbove) continue;
+        if (leaf) {
+          setState(state, i, uint8_t(CutVisibility::Untested));  // a record of another forest
+          coverEnd[i] = nodeEnd;
         } else {
           above = true;
         }
-        cursor[i] = c;
       }
       if (above) {
         // Samples disagree on how fine the cut is here. Where every sample's cut under this
@@ -133,58 +165,51 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         // so, the coarser cut will do.
         const uint8_t vf = uint8_t(CutVisibility::Visible) | kFirstOrderBit;
         bool kept = false, ok = true;
-        const uint32_t last = pre + 2 * n.lights() - 1;  // (`above`: an inner node)  // the subtree's preorder range
         uint32_t past[kMaxSamples];  // per refining sample: its first entry after the subtree
         for (int i = 0; i < count && ok; ++i) {
-          if (stateOf(it.state, i) == kAbove) continue;
-          kept |= stateOf(it.state, i) == vf && (exact >> i & 1);
-          ok = stateOf(it.state, i) == vf;
+          if (stateOf(state, i) == kAbove) continue;
+          kept |= stateOf(state, i) == vf && (exact >> i & 1);
+          ok = stateOf(state, i) == vf;
         }
         // ... as long as the samples are close together seen from the cluster: the coarser
         // cut was chosen for the sample that kept it.
         ok = ok && kept && distance2Box(n, samples[0]->point) >= kCoarsenRatio2 * spread2;
         for (int i = 0; i < count && ok; ++i) {
-          if (stateOf(it.state, i) != kAbove) continue;
+          if (stateOf(state, i) != kAbove) continue;
           const uint32_t* e = samples[i]->entries.data();
-          past[i] = uint32_t(std::lower_bound(e + cursor[i], e + end[i], last,
+          past[i] = uint32_t(std::lower_bound(e + cursor[i], e + end[i], nodeEnd,
                                               [](uint32_t en, uint32_t p) { return CutRecord::preorderOf(en) < p; }) - e);
           ok = rough[i][past[i]] == rough[i][cursor[i]];
         }
         if (ok) {
           for (int i = 0; i < count; ++i) {
-            if (stateOf(it.state, i) != kAbove) continue;
+            if (stateOf(state, i) != kAbove) continue;
             cursor[i] = past[i];
-            setState(it.state, i, vf);
+            setState(state, i, vf);
+            coverEnd[i] = nodeEnd;
           }
           above = false;
         }
       }
+      for (int i = 0; i < count; ++i)
+        if (exact >> i & 1) coverEnd[i] = nodeEnd;
       if (above) {
-        // The children inherit states, not the entries (their `exact` starts at 0).
-        // The left child is read next (an inner one is the next slot), the right one when
-        // the left subtree is done: both are fetched now (a leaf child: its light), so the
-        // right one has arrived by then (unfetched, its line was 15% of the merge at 8.1M
-        // lights, perf).
-        const NodeRef left = n.left(it.node), right = n.right(it.node);
-        for (NodeRef c : {left, right})
-          __builtin_prefetch(isLeafRef(c) ? static_cast<const void*>(&lights.lights[leafLight(c)])
-                                          : static_cast<const void*>(&tree.nodes[c]));
-        stack.push_back(Item{right, n.rightPre(pre), it.state});
-        it.node = left;  // the left child next: the walk stays in preorder
-        it.pre = LightNode::leftPre(pre);
-        descending = true;
+        // The finer samples' next entries lie in this node's subtree; the samples that kept
+        // the node lend it their states until its end.
+        pos = next;
         continue;
       }
+      pos = nodeEnd;
       int visible = 0, occluded = 0, partial = 0, firstOrder = 0, exacts = 0;
       float factorSum = 0;
       for (int i = 0; i < count; ++i) {
-        firstOrder += (stateOf(it.state, i) & kFirstOrderBit) != 0;
+        firstOrder += (stateOf(state, i) & kFirstOrderBit) != 0;
         if (exact >> i & 1) {
           const std::vector<float>& f = samples[i]->factor;
           ++exacts;
-          factorSum += cursor[i] - 1 < f.size() ? f[cursor[i] - 1] : 1.0f;
+          factorSum += exactAt[i] < f.size() ? f[exactAt[i]] : 1.0f;
         }
-        auto s = CutVisibility(stateOf(it.state, i) & 3);
+        auto s = CutVisibility(stateOf(state, i) & 3);
         visible += s == CutVisibility::Visible;
         occluded += s == CutVisibility::Occluded;
         partial += s == CutVisibility::Partial;
@@ -192,7 +217,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       if (count > 0 && occluded == count) {
         ++out.occluded;
         if (tree.type == LightType::Omni || tree.type == LightType::Oriented)
-          out.hidden.push_back(MergedCut::Node{n.intensity, n.rep, true, false, false, 1.0f, t, it.node});
+          out.hidden.push_back(MergedCut::Node{n.intensity, n.rep, true, false, false, 1.0f, t, node});
         continue;
       }
       bool needsRay = occluded > 0 || partial > 0 || visible == 0;
@@ -200,7 +225,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       const float factor = firstOrder == count && exacts > 0 ? factorSum / float(exacts) : 1.0f;
       const bool batched = !needsRay && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
       // The group and the batch wait for the pass below, which fetches the lights ahead.
-      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, needsRay, batched, disagree, factor, t, it.node});
+      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, needsRay, batched, disagree, factor, t, node});
     }
   }
   // The representatives' lights are scattered over the light array: a cache miss each when

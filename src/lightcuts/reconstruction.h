@@ -47,6 +47,9 @@ enum class CutVisibility : uint8_t {
 // as preorder << 3 | firstOrder << 2 | visibility.
 struct CutRecord {
   std::vector<uint32_t> entries;
+  // Per entry: its node, so that a merge goes from entry to entry without walking the
+  // tree above them.
+  std::vector<NodeRef> nodes;
   // Per entry: the first-order estimate over the representative's (both unshadowed), 1
   // where the first-order estimate was not used. A point near the sample borrows it: the
   // correction changes with the point far more slowly than the contribution does.
@@ -57,6 +60,7 @@ struct CutRecord {
 
   void clear() {
     entries.clear();
+    nodes.clear();
     factor.clear();
     treeBegin.clear();
     valid = false;

@@ -107,8 +107,11 @@ TEST(Reconstruction, RecordedCutIsThePartitionTheLightcutUsed) {
   const LightTree& t = f.forest.trees[0];
   const std::vector<NodeRef> byPre = t.preorderNodes();
   uint32_t next = 0, leaves = 0;
-  for (uint32_t e : r.entries) {
+  ASSERT_EQ(r.nodes.size(), r.entries.size());
+  for (size_t i = 0; i < r.entries.size(); ++i) {
+    const uint32_t e = r.entries[i];
     NodeRef node = byPre[CutRecord::preorderOf(e)];
+    EXPECT_EQ(r.nodes[i], node) << "the entry's node";
     EXPECT_GE(CutRecord::preorderOf(e), next) << "overlapping subtrees";
     next = CutRecord::preorderOf(e) + subtreeSize(t, node);
     leaves += test_lights::leafCount(t, node);
@@ -387,6 +390,7 @@ TEST(Reconstruction, AgreeingSmoothVisibleSamplesKeepTheCoarserCut) {
     c.valid = true;
     c.entries = std::move(entries);
     c.factor = std::move(factors);
+    for (uint32_t e : c.entries) c.nodes.push_back(t.preorderNodes()[CutRecord::preorderOf(e)]);
     c.treeBegin = {0, uint32_t(c.entries.size())};
     return c;
   };
@@ -424,6 +428,58 @@ TEST(Reconstruction, AgreeingSmoothVisibleSamplesKeepTheCoarserCut) {
   lc->mergeSamples(ab2, 2, m);
   ASSERT_EQ(m.nodes.size(), 2u);
   EXPECT_FLOAT_EQ(m.nodes[1].factor, 1.0f);
+}
+
+// Each sample refines a different half: the merged cut is the finer entry on each side,
+// the coarser sample's visibility lent to the finer one's nodes under it.
+TEST(Reconstruction, MergedCutTakesTheFinerEntryOnEachSide) {
+  LightSet lights = cloud(64, LightType::Omni, 3);
+  LightForest forest = buildLightForest(lights);
+  auto lc = makeLightcuts(lights, forest, CutOptions{});
+  const LightTree& t = forest.trees[0];
+  const std::vector<NodeRef> byPre = t.preorderNodes();
+  const NodeRef l = t.nodes[0].left(0), r = t.nodes[0].right(0);
+  ASSERT_FALSE(isLeafRef(l));
+  ASSERT_FALSE(isLeafRef(r));
+  const NodeRef ll = t.nodes[l].left(l), lr = t.nodes[l].right(l), rl = t.nodes[r].left(r), rr = t.nodes[r].right(r);
+  auto pre = [&](NodeRef n) { return preorderOf(t, n); };
+  auto rec = [&](std::vector<std::pair<NodeRef, CutVisibility>> cut) {
+    CutRecord c;
+    c.valid = true;
+    for (auto [n, v] : cut) {
+      c.entries.push_back(CutRecord::pack(pre(n), v));
+      c.nodes.push_back(n);
+      c.factor.push_back(1);
+    }
+    c.treeBegin = {0, uint32_t(c.entries.size())};
+    return c;
+  };
+  const CutVisibility V = CutVisibility::Visible, O = CutVisibility::Occluded;
+  CutRecord a = rec({{ll, V}, {lr, O}, {r, V}});
+  CutRecord b = rec({{l, O}, {rl, V}, {rr, V}});
+  ASSERT_EQ(byPre[pre(rr)], rr);
+  const CutRecord* ab[2] = {&a, &b};
+  MergedCut m;
+  lc->mergeSamples(ab, 2, m);
+  // ll: A visible, B (through l) occluded: a ray; lr: both occluded, left out of `nodes`;
+  // rl and rr: both visible.
+  ASSERT_EQ(m.nodes.size(), 3u);
+  EXPECT_EQ(m.occluded, 1u);
+  EXPECT_EQ(m.nodes[0].node, ll);
+  EXPECT_TRUE(m.nodes[0].needsRay);
+  EXPECT_TRUE(m.nodes[0].disagree);
+  EXPECT_EQ(m.nodes[1].node, rl);
+  EXPECT_FALSE(m.nodes[1].needsRay);
+  EXPECT_EQ(m.nodes[2].node, rr);
+  EXPECT_FALSE(m.nodes[2].needsRay);
+  ASSERT_EQ(m.hidden.size(), 1u);
+  EXPECT_EQ(m.hidden[0].node, lr);
+  // The same merge in the other order of samples.
+  const CutRecord* ba[2] = {&b, &a};
+  MergedCut m2;
+  lc->mergeSamples(ba, 2, m2);
+  ASSERT_EQ(m2.nodes.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) EXPECT_EQ(m2.nodes[i].node, m.nodes[i].node);
 }
 
 }  // namespace
