@@ -26,6 +26,7 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <array>
 #include <queue>
@@ -36,6 +37,11 @@
 #endif
 
 #include "lightcuts/cluster.h"
+
+// ApproximateClustering's vector helpers take and return eight-lane vectors only where they
+// are inlined (always_inline) into metricRowAvx2, so no call passes one across the ABI that
+// GCC warns about (its warning comes where the templates are instantiated, the file's end).
+#pragma GCC diagnostic ignored "-Wpsabi"
 
 namespace lc::lightcuts {
 
@@ -583,7 +589,7 @@ class ApproximateClustering {
   static constexpr double kAlpha = 0.4;
 
   ApproximateClustering(ClusterStore& all, bool withCone, float coneWeight, uint64_t seed)
-      : all_(all), withCone_(withCone), c2_(coneWeight * coneWeight), seed_(seed) {}
+      : all_(all), withCone_(withCone), c2_(coneWeight * coneWeight), seed_(seed), lanes_(detail::metricLanes()) {}
 
   // Clusters kept by a group of n: f(n) = c n^alpha with f(delta) = delta / 2.
   static size_t keep(size_t n) {
@@ -652,77 +658,116 @@ class ApproximateClustering {
     return r;
   }
 
-  // The clusters of a combine() as columns, four lanes at a time (GCC/Clang vector
-  // extensions: SSE on x86-64, plain code elsewhere). metricRow() computes the merge metric
+  // The clusters of a combine() as columns, several lanes at a time (GCC/Clang vector
+  // extensions: SSE on x86-64, or AVX2's eight lanes where the CPU has them; plain code
+  // elsewhere). metricRow() computes the merge metric
   // (a.weight + x.weight) * (|union box diagonal|^2 + c^2 (1 - cos union half-angle)^2)
   // from one cluster to all of them, with the operations of the scalar form in its order
   // (min/max/clamp as std:: defines them, no FMA contraction): the trees are the same bit
-  // for bit as when it was computed pair by pair (perf, 1M VPLs: 12.3% of the run's
-  // samples then, 9.7% now). Both orders, a to x and x to a, as the cone union's rounding
-  // is not symmetric.
+  // for bit as when it was computed pair by pair, at any lane width (perf, 1M VPLs: 12.3% of
+  // the run's samples then, 9.7% with four lanes; at 8.1M lights it was still 18% of the
+  // VPL and tree phases, and eight lanes take ~2/5 off it). Both orders, a to x and x to a,
+  // as the cone union's rounding is not symmetric.
   using V4 = float __attribute__((vector_size(16)));
+  using V8 = float __attribute__((vector_size(32)));
   struct Columns {
     std::vector<float> f[11];  // lo xyz, hi xyz, axis xyz, halfAngle, weight
     void resize(size_t m) {
-      for (auto& v : f) v.resize((m + 3) & ~size_t(3), 0.0f);
+      for (auto& v : f) v.resize((m + 7) & ~size_t(7), 0.0f);  // whole blocks of 8 lanes
     }
     void set(size_t k, const Cluster& c) {
       const float v[11] = {c.lo.x, c.lo.y, c.lo.z, c.hi.x, c.hi.y, c.hi.z, c.axis.x, c.axis.y, c.axis.z, c.halfAngle, c.weight};
       for (int q = 0; q < 11; ++q) f[q][k] = v[q];
     }
-    V4 at(int q, size_t k) const {
-      V4 r;
+    template <class V>
+    __attribute__((always_inline)) V at(int q, size_t k) const {
+      V r;
       __builtin_memcpy(&r, &f[q][k], sizeof r);
       return r;
     }
   };
-  static V4 vmin4(V4 a, V4 b) { return b < a ? b : a; }  // std::min(a, b)
-  static V4 vmax4(V4 a, V4 b) { return a < b ? b : a; }  // std::max(a, b)
-  static V4 splat(float x) { return V4{x, x, x, x}; }
-  static V4 fastAcos4(V4 x) {
-    x = vmin4(vmax4(x, splat(-1.0f)), splat(1.0f));  // std::clamp(x, -1, 1)
-    V4 ax = x < 0 ? -x : x;
-    V4 t = splat(1.0f) - ax, sq;
-    for (int l = 0; l < 4; ++l) sq[l] = std::sqrt(t[l]);
-    V4 r = sq * (splat(1.5707288f) + ax * (splat(-0.2121144f) + ax * (splat(0.0742610f) - splat(0.0187293f) * ax)));
-    return x >= 0 ? r : splat(kPi) - r;
+  template <class V>
+  static constexpr int kLanes = int(sizeof(V) / sizeof(float));
+  template <class V>
+  __attribute__((always_inline)) static V vmin(V a, V b) { return b < a ? b : a; }  // std::min(a, b)
+  template <class V>
+  __attribute__((always_inline)) static V vmax(V a, V b) { return a < b ? b : a; }  // std::max(a, b)
+  template <class V>
+  __attribute__((always_inline)) static V splat(float x) {
+    V r;
+    for (int l = 0; l < kLanes<V>; ++l) r[l] = x;
+    return r;
   }
-  static V4 oneMinusCos4(V4 t) {
-    V4 u = splat(0.5f) * vmin4(vmax4(t, splat(0.0f)), splat(kPi)), u2 = u * u;
-    V4 s = u * (splat(1.0f) - u2 * (splat(1.0f / 6) - u2 * (splat(1.0f / 120) - u2 * splat(1.0f / 5040))));
-    return splat(2.0f) * s * s;
+  template <class V>
+  __attribute__((always_inline)) static V fastAcosV(V x) {
+    x = vmin(vmax(x, splat<V>(-1.0f)), splat<V>(1.0f));  // std::clamp(x, -1, 1)
+    V ax = x < 0 ? -x : x;
+    V t = splat<V>(1.0f) - ax, sq;
+    for (int l = 0; l < kLanes<V>; ++l) sq[l] = std::sqrt(t[l]);
+    V r = sq * (splat<V>(1.5707288f) +
+                ax * (splat<V>(-0.2121144f) + ax * (splat<V>(0.0742610f) - splat<V>(0.0187293f) * ax)));
+    return x >= 0 ? r : splat<V>(kPi) - r;
   }
-  static V4 unionHalfAngle4(V4 ta, V4 tb, V4 td) {
-    V4 pi = splat(kPi);
-    V4 r = vmin4(pi, splat(0.5f) * (ta + td + tb));
-    r = vmin4(td + ta, pi) <= tb ? tb : r;
-    return vmin4(td + tb, pi) <= ta ? ta : r;
+  template <class V>
+  __attribute__((always_inline)) static V oneMinusCosV(V t) {
+    V u = splat<V>(0.5f) * vmin(vmax(t, splat<V>(0.0f)), splat<V>(kPi)), u2 = u * u;
+    V s = u * (splat<V>(1.0f) -
+               u2 * (splat<V>(1.0f / 6) - u2 * (splat<V>(1.0f / 120) - u2 * splat<V>(1.0f / 5040))));
+    return splat<V>(2.0f) * s * s;
+  }
+  template <class V>
+  __attribute__((always_inline)) static V unionHalfAngleV(V ta, V tb, V td) {
+    V pi = splat<V>(kPi);
+    V r = vmin(pi, splat<V>(0.5f) * (ta + td + tb));
+    r = vmin(td + ta, pi) <= tb ? tb : r;
+    return vmin(td + tb, pi) <= ta ? ta : r;
   }
   // The metric from a to cluster k for k in [begin, end) into row[k] (a to k) and col[k] (k to a);
   // lanes past end are computed from padding and not written.
-  void metricRow(const Cluster& a, const Columns& x, size_t begin, size_t end, float* row, float* col) const {
-    const V4 alx = splat(a.lo.x), aly = splat(a.lo.y), alz = splat(a.lo.z);
-    const V4 ahx = splat(a.hi.x), ahy = splat(a.hi.y), ahz = splat(a.hi.z);
-    const V4 aax = splat(a.axis.x), aay = splat(a.axis.y), aaz = splat(a.axis.z);
-    const V4 aw = splat(a.weight), ah = splat(a.halfAngle), c2 = splat(c2_);
-    for (size_t k = begin & ~size_t(3); k < end; k += 4) {
-      V4 ex = vmax4(ahx, x.at(3, k)) - vmin4(alx, x.at(0, k));
-      V4 ey = vmax4(ahy, x.at(4, k)) - vmin4(aly, x.at(1, k));
-      V4 ez = vmax4(ahz, x.at(5, k)) - vmin4(alz, x.at(2, k));
-      V4 m = ex * ex + ey * ey + ez * ez, m2 = m;
+  template <class V>
+  __attribute__((always_inline)) inline void metricRowLanes(const Cluster& a, const Columns& x, size_t begin,
+                                                            size_t end, float* row, float* col) const {
+    constexpr size_t N = size_t(kLanes<V>);
+    const V alx = splat<V>(a.lo.x), aly = splat<V>(a.lo.y), alz = splat<V>(a.lo.z);
+    const V ahx = splat<V>(a.hi.x), ahy = splat<V>(a.hi.y), ahz = splat<V>(a.hi.z);
+    const V aax = splat<V>(a.axis.x), aay = splat<V>(a.axis.y), aaz = splat<V>(a.axis.z);
+    const V aw = splat<V>(a.weight), ah = splat<V>(a.halfAngle), c2 = splat<V>(c2_);
+    for (size_t k = begin & ~(N - 1); k < end; k += N) {
+      V ex = vmax(ahx, x.at<V>(3, k)) - vmin(alx, x.at<V>(0, k));
+      V ey = vmax(ahy, x.at<V>(4, k)) - vmin(aly, x.at<V>(1, k));
+      V ez = vmax(ahz, x.at<V>(5, k)) - vmin(alz, x.at<V>(2, k));
+      V m = ex * ex + ey * ey + ez * ez, m2 = m;
       if (withCone_) {
-        V4 td = fastAcos4(aax * x.at(6, k) + aay * x.at(7, k) + aaz * x.at(8, k));
-        V4 xh = x.at(9, k);
-        V4 o1 = oneMinusCos4(unionHalfAngle4(ah, xh, td)), o2 = oneMinusCos4(unionHalfAngle4(xh, ah, td));
+        V td = fastAcosV(aax * x.at<V>(6, k) + aay * x.at<V>(7, k) + aaz * x.at<V>(8, k));
+        V xh = x.at<V>(9, k);
+        V o1 = oneMinusCosV(unionHalfAngleV(ah, xh, td)), o2 = oneMinusCosV(unionHalfAngleV(xh, ah, td));
         m += c2 * o1 * o1;
         m2 += c2 * o2 * o2;
       }
-      const V4 w = aw + x.at(10, k), ax = w * m, xa = w * m2;
-      for (size_t l = std::max(k, begin); l < std::min(k + 4, end); ++l) {
+      const V w = aw + x.at<V>(10, k), ax = w * m, xa = w * m2;
+      if (k >= begin && k + N <= end) {  // a whole block: one store each (not a memcpy call)
+        __builtin_memcpy(row + k, &ax, sizeof ax);
+        __builtin_memcpy(col + k, &xa, sizeof xa);
+        continue;
+      }
+      for (size_t l = std::max(k, begin); l < std::min(k + N, end); ++l) {
         row[l] = ax[l - k];
         col[l] = xa[l - k];
       }
     }
+  }
+#if defined(__x86_64__) && defined(__GNUC__)
+  // AVX2 only, not FMA: a contracted multiply-add would round differently from the scalar form.
+  __attribute__((target("avx2"))) void metricRowAvx2(const Cluster& a, const Columns& x, size_t begin, size_t end,
+                                                     float* row, float* col) const {
+    metricRowLanes<V8>(a, x, begin, end, row, col);
+  }
+#endif
+  void metricRow(const Cluster& a, const Columns& x, size_t begin, size_t end, float* row, float* col) const {
+#if defined(__x86_64__) && defined(__GNUC__)
+    if (lanes_ == 8) return metricRowAvx2(a, x, begin, end, row, col);
+#endif
+    metricRowLanes<V4>(a, x, begin, end, row, col);
   }
 
   // Greedy merging inside a small set, nearest neighbours by brute force over a matrix of
@@ -840,9 +885,37 @@ class ApproximateClustering {
   bool withCone_;
   float c2_;
   uint64_t seed_;
+  int lanes_;  // metricRow's lane width (detail::metricLanes)
 };
 
 }  // namespace
+
+namespace detail {
+
+namespace {
+std::atomic<int> forcedMetricLanes{0};
+bool hasAvx2() {
+#if defined(__x86_64__) && defined(__GNUC__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+#else
+  return false;
+#endif
+}
+}  // namespace
+
+int metricLanes() {
+  const int forced = forcedMetricLanes.load(std::memory_order_relaxed);
+  return forced ? forced : hasAvx2() ? 8 : 4;
+}
+
+int setMetricLanes(int lanes) {
+  forcedMetricLanes.store(lanes == 8 && !hasAvx2() ? 4 : lanes == 4 || lanes == 8 ? lanes : 0,
+                          std::memory_order_relaxed);
+  return metricLanes();
+}
+
+}  // namespace detail
 
 LightTree buildAgglomerativeTree(const LightSet& lights, const std::vector<uint32_t>& indices,
                                  LightType type, float coneWeight, uint64_t seed, size_t exactLimit,

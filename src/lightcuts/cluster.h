@@ -32,6 +32,12 @@ struct Cluster {
   uint32_t count = 1;  // lights below (fills what would be padding)
 };
 
+// The lane width of the agglomerative builder's merge-metric rows: 8 where the CPU has AVX2,
+// else 4; the trees are the same bit for bit either way. setMetricLanes(4 or 8) forces one
+// for tests (8 falls back to 4 without AVX2; 0 = by CPU again) and returns the width in use.
+int metricLanes();
+int setMetricLanes(int lanes);
+
 // Position a light occupies in its tree: directional lights cluster by the direction
 // toward them.
 inline Vec3 clusterPoint(const Light& l) {

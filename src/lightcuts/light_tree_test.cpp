@@ -1,3 +1,4 @@
+#include "lightcuts/cluster.h"
 #include "lightcuts/light_tree.h"
 #include "lightcuts/bounds.h"
 #include "test_lights.h"
@@ -8,6 +9,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <future>
 #include <memory>
@@ -260,6 +262,30 @@ TEST(Agglomerative, ParallelLayoutAndMomentsEqualSerialPasses) {
       ASSERT_EQ(got.centroid, ref[i].centroid) << i;
       ASSERT_EQ(got.meanAxis, ref[i].meanAxis) << i;
     }
+  }
+}
+
+// The merge metric is computed four or eight lanes at a time (AVX2, where the CPU has it):
+// the same trees bit for bit either way, for every kind of light the metric treats apart.
+TEST(Agglomerative, EightLaneMetricGivesTheSameTreesAsFour) {
+  if (detail::setMetricLanes(8) != 8) {
+    detail::setMetricLanes(0);
+    GTEST_SKIP() << "no AVX2 on this CPU";
+  }
+  for (LightType type : {LightType::Omni, LightType::Oriented, LightType::Directional}) {
+    LightSet set = randomLights(30000, type, 41, true);
+    TreeBuildOptions o{TreeBuilder::Agglomerative, 5};
+    o.exactLimit = 512;  // the bottom-up groups, where the rows are computed
+    detail::setMetricLanes(8);
+    LightForest eight = buildLightForest(set, o);
+    detail::setMetricLanes(4);
+    LightForest four = buildLightForest(set, o);
+    detail::setMetricLanes(0);
+    const LightTree &a = eight.trees[0], &b = four.trees[0];
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    ASSERT_EQ(a.root, b.root);
+    for (size_t i = 0; i < a.nodes.size(); ++i)
+      ASSERT_EQ(std::memcmp(&a.nodes[i], &b.nodes[i], sizeof(LightNode)), 0) << "node " << i;
   }
 }
 
