@@ -564,24 +564,6 @@ class TreeWriter {
 
 namespace {
 
-// 10 bits per axis of Morton order within `b`.
-uint32_t mortonCode(const Vec3& p, const Bounds3& b) {
-  auto spread = [](uint32_t x) {
-    x = (x | (x << 16)) & 0x030000FFu;
-    x = (x | (x << 8)) & 0x0300F00Fu;
-    x = (x | (x << 4)) & 0x030C30C3u;
-    x = (x | (x << 2)) & 0x09249249u;
-    return x;
-  };
-  Vec3 e = b.extent();
-  uint32_t q[3];
-  for (int i = 0; i < 3; ++i) {
-    float t = e[i] > 0 ? (p[i] - b.lo[i]) / e[i] : 0.5f;
-    q[i] = uint32_t(std::clamp(t * 1023.0f, 0.0f, 1023.0f));
-  }
-  return (spread(q[0]) << 2) | (spread(q[1]) << 1) | spread(q[2]);
-}
-
 // The bottom-up stage for large light sets (AAC-HQ parameters of Gu et al. 2013).
 class ApproximateClustering {
  public:

@@ -1,8 +1,9 @@
 // Reconstruction cuts (Walter et al. 2005, sec. 5): share the work of lightcuts between
 // nearby shading points. A sparse set of "samples" (in the renderer: every Nth pixel in x
 // and y) get a full lightcut, recorded as a CutRecord: the cut's nodes with what the shadow
-// ray of each node's representative found. A point between samples then walks the light
-// tree top down and, at each node, looks at what its samples did there:
+// ray of each node's representative found. A point between samples then takes the light
+// tree top down (mergeCuts does it as a merge of the samples' entries, with the walk's
+// result) and, at each node, looks at what its samples did there:
 //   - some sample refined the node (its cut lies below): descend to the children;
 //   - every sample kept the node (or an ancestor) and found it occluded: it contributes 0
 //     (unless a probe finds its group visible at the point: MergedCut::hidden);

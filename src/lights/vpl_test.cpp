@@ -1,6 +1,7 @@
 #include "lights/vpl.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include "io/ray_parser.h"
 #include "test_scenes.h"
@@ -50,6 +51,38 @@ TEST(Vpl, SameSeedSameVpls) {
     ASSERT_EQ(a->lights().lights[i].position, b->lights().lights[i].position);
     ASSERT_EQ(a->lights().lights[i].intensity, b->lights().lights[i].intensity);
   }
+}
+
+// The VPLs lie in the light array by cells of space (their Morton code's top bits in the
+// scene's box), the same lights in the same order on one thread or several.
+TEST(Vpl, VplsLieByCellsOfSpaceWhateverTheThreadCount) {
+  auto a = closedBox(0.5f, 1.0f), b = closedBox(0.5f, 1.0f);
+  VplOptions o;
+  o.count = 30000;
+  o.bounces = 2;
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    addVpls(*a, o);
+  }
+  {
+    tbb::global_control four(tbb::global_control::max_allowed_parallelism, 4);
+    addVpls(*b, o);
+  }
+  const LightSet &la = a->lights(), &lb = b->lights();
+  ASSERT_EQ(la.size(), lb.size());
+  const Bounds3 box = a->bounds();
+  uint32_t lastCell = 0;
+  size_t vpls = 0;
+  for (size_t i = 0; i < la.size(); ++i) {
+    ASSERT_EQ(la.lights[i].position, lb.lights[i].position) << i;
+    ASSERT_EQ(la.lights[i].intensity, lb.lights[i].intensity) << i;
+    if (!la.groups[la.lights[i].group].isVpl) continue;
+    const uint32_t cell = mortonCode(la.lights[i].position, box) >> 15;
+    EXPECT_GE(cell, lastCell) << "VPL " << i << " is out of its cell's order";
+    lastCell = cell;
+    ++vpls;
+  }
+  EXPECT_GT(vpls, 30000u);
 }
 
 TEST(Vpl, ClampIsTheAttenuationOfEveryMethod) {
