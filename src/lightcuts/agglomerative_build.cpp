@@ -41,7 +41,9 @@
 // ApproximateClustering's vector helpers take and return eight-lane vectors only where they
 // are inlined (always_inline) into metricRowAvx2, so no call passes one across the ABI that
 // GCC warns about (its warning comes where the templates are instantiated, the file's end).
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wpsabi"
+#endif
 
 namespace lc::lightcuts {
 
