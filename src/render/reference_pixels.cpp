@@ -139,12 +139,12 @@ double vplClampedFraction(const scene::Scene& scene, const RenderOptions& o, int
   if (vpls.empty()) return 0;
   // At each of `points` points, every VPL, or when that would exceed maxEvaluations an
   // evenly strided subset (every stride-th of the light array, from an offset of the
-  // point's own). The VPLs lie there by cells of space (lights/vpl.cpp), so the subset is
-  // spread evenly over space. Measured against every VPL at every point (Cornell box, 256²):
-  // 1.24% for an exact 1.01% at 1M paths, 1.42% for 1.01% at 10M; the same stride in path
-  // order gave 0.87% and 0.94%, and random subsets 0.64% and 0.52%: the share hangs on the
-  // few VPLs nearest each point, which any subset catches or misses. The clamped share is dominated by the few VPLs nearest each point, so many points
-  // with a subset each estimate it far better than a few with all: at 813,502 VPLs, 256
+  // point's own; the VPLs lie there by cells of space, lights/vpl.cpp, so the subset is
+  // spread evenly over space). The clamped share is dominated by the few VPLs nearest each
+  // point, which any subset catches or misses: against every VPL at every point (Cornell
+  // box, 256²), 1.24% for an exact 1.01% at 1M paths and 1.42% for 1.01% at 10M (the same
+  // stride in path order gave 0.87% and 0.94%, random subsets 0.64% and 0.52%). Still, many
+  // points with a subset each estimate it far better than a few with all: at 813,502 VPLs, 256
   // points with all of them gave 2.63%, 19 points with all 6.66%, 256 points with every
   // 53rd 2.48%. (At 10M VPL paths, 16 points with all 8.1M VPLs took about 8 s.)
   const uint64_t budget = std::max<uint64_t>(maxEvaluations, 1);
