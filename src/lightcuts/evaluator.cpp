@@ -8,6 +8,7 @@
 
 #include "core/error.h"
 #include "lightcuts/bounds.h"
+#include "lightcuts/bounds_pair.h"
 #include "lightcuts/exact_sum.h"
 
 namespace lc::lightcuts {
@@ -321,9 +322,11 @@ class Lightcuts final : public LightEvaluator {
     };
     // Node ni, at preorder position pre.
     // clear: the node's parent was clear (Visibility::boxClear), and so is the node;
-    // blocker: what stopped the last such test on its way down (a hint for its own).
+    // blocker: what stopped the last such test on its way down (a hint for its own);
+    // bounds: its bounds when they were computed with its sibling's (clusterBoundsPair).
     auto addNode = [&](uint32_t t, NodeRef ni, uint32_t pre, const Color& unit, const ShadowResult& shadow,
-                       bool boundary = false, bool clear = false, uint32_t blocker = Visibility::kNoHint) {
+                       bool boundary = false, bool clear = false, uint32_t blocker = Visibility::kNoHint,
+                       const ChildBounds* bounds = nullptr) {
       const CutVisibility found = shadow.found;
       const LightTree& tree = forest_.trees[t];
       if (isLeafRef(ni)) {
@@ -343,11 +346,19 @@ class Lightcuts final : public LightEvaluator {
       // lower bound of its unshadowed light; otherwise (or when it is partly hidden, which
       // the per-node rule still bounds) within the upper bound.
       bool visible = (rss || firstOrder) && !isBlack(unit);
-      Color lower;
+      Color lower, upper;
       bool smooth = false;
-      // A tree that mixes groups bounds from below with their lower envelope (LightTree).
-      Color upper = clusterBounds(n, tree.type, tree.bound, sp, frames, visible ? &lower : nullptr, &smooth,
-                                  tree.mixedGroups ? &tree.boundLow : nullptr);
+      if (bounds) {
+        upper = bounds->upper;
+        if (visible) {
+          lower = bounds->lower;
+          smooth = bounds->smooth;
+        }
+      } else {
+        // A tree that mixes groups bounds from below with their lower envelope (LightTree).
+        upper = clusterBounds(n, tree.type, tree.bound, sp, frames, visible ? &lower : nullptr, &smooth,
+                              tree.mixedGroups ? &tree.boundLow : nullptr);
+      }
       float b = luminance(upper);
       if (b > 0) {
         // A node in the heap may be refined next: fetch its children while we work (a
@@ -488,8 +499,16 @@ class Lightcuts final : public LightEvaluator {
         ++refinedTested;
         refinedSplit += boundary;
       }
-      addNode(cn.tree, cn.left, LightNode::leftPre(cn.pre), units[0], shadows[0], boundary, cnClear, blocker);
-      addNode(cn.tree, cn.right, cn.rightPre, units[1], shadows[1], boundary, cnClear, blocker);
+      // Two inner children are bounded together (bounds_pair.h): the same bounds, for about
+      // half the instructions.
+      ChildBounds pair[2];
+      const bool paired =
+          !isLeafRef(cn.left) && !isLeafRef(cn.right) && boundsPairApplies(tree.type, tree.mixedGroups);
+      if (paired) clusterBoundsPair(tree.nodes[cn.left], tree.nodes[cn.right], tree.type, tree.bound, sp, frames, pair);
+      addNode(cn.tree, cn.left, LightNode::leftPre(cn.pre), units[0], shadows[0], boundary, cnClear, blocker,
+              paired ? &pair[0] : nullptr);
+      addNode(cn.tree, cn.right, cn.rightPre, units[1], shadows[1], boundary, cnClear, blocker,
+              paired ? &pair[1] : nullptr);
       // A second stage of prefetching: the children of the nodes pushed one refinement ago
       // have arrived (addNode fetched them); fetch their representatives' lights, which the
       // next refinement's shadow ray reads (a miss on the light was half of
