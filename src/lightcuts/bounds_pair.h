@@ -2,10 +2,10 @@
 // cut bounds one right after the other (issue 21: "SIMD bounds, both children of a node at
 // once"). Each child is one lane of SSE registers, and every lane goes through the very
 // operations clusterBounds (bounds.h) does, in the same order and without fused
-// multiply-adds, so the results are the same bit for bit (bounds_test.cpp checks it on
-// random clusters). Only the specular power stays scalar, per lane.
-// For omni and oriented trees that do not mix groups (boundsPairApplies); the other kinds
-// go through clusterBounds one child at a time.
+// multiply-adds, so the results are the same bit for bit (bounds_pair_test.cpp checks it on
+// random clusters). Only the specular power and the spot falloff stay scalar, per lane.
+// For omni, oriented and spot trees that do not mix groups (boundsPairApplies); directional
+// trees and mixed ones go through clusterBounds one child at a time.
 #pragma once
 
 #include <cstring>
@@ -25,7 +25,7 @@ struct ChildBounds {
 };
 
 inline bool boundsPairApplies(LightType type, bool mixedGroups) {
-  return !mixedGroups && (type == LightType::Omni || type == LightType::Oriented);
+  return !mixedGroups && (type == LightType::Omni || type == LightType::Oriented || type == LightType::Spot);
 }
 
 #if defined(__SSE2__)
@@ -108,14 +108,15 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
   const __m128 dMaxPositive = _mm_cmpgt_ps(dMax, zero);
   const __m128 cNLo = _mm_and_ps(dMaxPositive, maxStd(zero, _mm_div_ps(nMinZ, dMax)));
   const __m128 mUpScale = minStd(one, _mm_add_ps(cN, slack));
-  __m128 smooth = _mm_cmpgt_ps(cNLo, zero);
+  // A spot's falloff is not smooth for the first-order estimate (clusterBounds).
+  __m128 smooth = type == LightType::Spot ? zero : _mm_cmpgt_ps(cNLo, zero);
   const bool specular = !g.diffuseOnly && sp.hasSpecular();
   __m128 cRUpSlack = zero, cRLo = zero;
   if (specular) {
     __m128 rMinZ;
     const __m128 cRUp = cosUpperLanes(fr.r, c, h, rMinZ);
     cRUpSlack = minStd(one, _mm_add_ps(cRUp, slack));
-    cRLo = _mm_and_ps(smooth, maxStd(zero, _mm_div_ps(rMinZ, dMax)));
+    cRLo = _mm_and_ps(_mm_cmpgt_ps(cNLo, zero), maxStd(zero, _mm_div_ps(rMinZ, dMax)));
     smooth = _mm_and_ps(smooth, _mm_cmpgt_ps(cRLo, zero));
   }
   __m128 denMin, denMax;
@@ -123,7 +124,10 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
   __m128 gLo = attenLanes(g.atten, dMax, denMax);
   smooth = _mm_and_ps(smooth, _mm_cmpgt_ps(gLo, zero));
   smooth = _mm_andnot_ps(_mm_and_ps(_mm_cmple_ps(denMin, one), _mm_cmpgt_ps(denMax, one)), smooth);
-  if (type == LightType::Oriented) {
+  // Spots: the cosines to their axes, through the falloff per lane below.
+  __m128 spotUp = zero, spotLo = zero;
+  const bool spot = type == LightType::Spot;
+  if (type == LightType::Oriented || spot) {
     const Lanes3 axis = pairOf(a.axis, b.axis);
     const __m128 pc = negLanes(dot(c, axis)), ph = dot(absLanes(axis), h);
     const __m128 up = _mm_add_ps(pc, ph);
@@ -138,7 +142,10 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
     const __m128 whole = _mm_or_ps(_mm_cmple_ps(cb, _mm_set1_ps(-1.0f)), _mm_cmpge_ps(cosUp, cb));
     __m128 cUp = maxStd(zero, select(whole, one, widened));
     cUp = select(_mm_cmpgt_ps(cUp, zero), minStd(one, _mm_add_ps(cUp, slack)), cUp);
-    gUp = _mm_mul_ps(gUp, cUp);
+    if (spot)
+      spotUp = cUp;
+    else
+      gUp = _mm_mul_ps(gUp, cUp);
     // coneNarrow(max(0, (pc - ph) / dMax), cb, sb) where dMax > 0, else 0
     const __m128 t = maxStd(zero, _mm_div_ps(_mm_sub_ps(pc, ph), dMax));
     const __m128 sT = _mm_sqrt_ps(maxStd(zero, _mm_sub_ps(one, _mm_mul_ps(t, t))));
@@ -146,10 +153,16 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
     const __m128 none = _mm_or_ps(_mm_cmple_ps(cb, zero), _mm_cmple_ps(t, zero));
     const __m128 cLo = _mm_and_ps(dMaxPositive, _mm_andnot_ps(none, narrowed));
     const __m128 cLoPositive = _mm_cmpgt_ps(cLo, zero);
-    gLo = _mm_and_ps(cLoPositive, _mm_mul_ps(gLo, cLo));
+    if (spot)
+      spotLo = cLo;
+    else
+      gLo = _mm_and_ps(cLoPositive, _mm_mul_ps(gLo, cLo));
     smooth = _mm_and_ps(smooth, cLoPositive);
   }
-  alignas(16) float vUp[4], vLo[4], vCN[4], vCR[4], vCRLo[4], vGUp[4], vGLo[4], vSm[4], vBehind[4];
+  alignas(16) float vUp[4], vLo[4], vCN[4], vCR[4], vCRLo[4], vGUp[4], vGLo[4], vSm[4], vBehind[4], vSpotUp[4],
+      vSpotLo[4];
+  _mm_store_ps(vSpotUp, spotUp);
+  _mm_store_ps(vSpotLo, spotLo);
   _mm_store_ps(vUp, mUpScale);
   _mm_store_ps(vLo, cNLo);
   _mm_store_ps(vCN, cN);
@@ -173,6 +186,10 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
     if (specular) {
       mUp += sp.ks * powNonNegative(vCR[k], sp.shininess);
       if (vLo[k] > 0) mLo += sp.ks * powNonNegative(vCRLo[k], sp.shininess);
+    }
+    if (spot) {
+      vGUp[k] *= g.falloff(vSpotUp[k]);
+      vGLo[k] *= vSpotLo[k] <= 0 ? 0.0f : g.falloff(vSpotLo[k]);
     }
     uint32_t smoothBits;
     std::memcpy(&smoothBits, &vSm[k], sizeof smoothBits);
