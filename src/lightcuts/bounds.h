@@ -137,13 +137,18 @@ inline CosRange unitCosBounds(const RotatedBox& b, const Vec3& target, const Lig
 // (estimate.h) valid.
 // `low`: the group the lower bound uses when it differs (a tree that mixes groups passes
 // their lower envelope, LightTree::boundLow); the contribution is then not called smooth.
+// Cosine bounds get a little slack so float rounding in the exact evaluation can never
+// exceed them (steep spot falloffs and high Phong exponents amplify it); and the final
+// bounds a little more, so that float rounding never puts the upper bound below an exact
+// value or the lower bound above it. (clusterBoundsPair, bounds_pair.h, uses the same.)
+constexpr float kCosSlack = 2e-5f;
+constexpr float kUpperScale = 1.0001f, kLowerScale = 0.9999f;
+
 inline Color clusterBounds(const LightNode& node, LightType type, const LightGroup& g, const ShadingPoint& sp,
                            const BoundFrames& fr, Color* lower, bool* smooth = nullptr,
                            const LightGroup* low = nullptr) {
   const LightGroup& gl = low ? *low : g;
-  // Cosine bounds get a little slack so float rounding in the exact evaluation can never
-  // exceed them (steep spot falloffs and high Phong exponents amplify it).
-  constexpr float kSlack = 2e-5f;
+  constexpr float kSlack = kCosSlack;
   if (lower) *lower = Color(0);
   if (smooth) *smooth = false;
   Vec3 lo, hi;  // vectors from the shading point toward the cluster's lights
@@ -224,10 +229,9 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
       }
     }
   }
-  if (lower) *lower = mLo * (gLo * 0.9999f) * node.intensity;
+  if (lower) *lower = mLo * (gLo * kLowerScale) * node.intensity;
   if (smooth) *smooth = sm;
-  // A little slack so float rounding never puts the bound below an exact value.
-  return mUp * (gUp * 1.0001f) * node.intensity;
+  return mUp * (gUp * kUpperScale) * node.intensity;
 }
 
 inline Color clusterBound(const LightNode& node, LightType type, const LightGroup& g, const ShadingPoint& sp,

@@ -91,8 +91,7 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
                               const ShadingPoint& sp, const BoundFrames& fr, ChildBounds out[2]) {
 #if defined(__SSE2__)
   using namespace detail;
-  constexpr float kSlack = 2e-5f;  // as clusterBounds'
-  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), slack = _mm_set1_ps(kSlack);
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), slack = _mm_set1_ps(kCosSlack);
   const Lanes3 p = splat(sp.p);
   const Lanes3 lo = pairOf(a.lo, b.lo) - p, hi = pairOf(a.hi, b.hi) - p;
   const __m128 half = _mm_set1_ps(0.5f);
@@ -159,13 +158,12 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
       gLo = _mm_and_ps(cLoPositive, _mm_mul_ps(gLo, cLo));
     smooth = _mm_and_ps(smooth, cLoPositive);
   }
-  alignas(16) float vUp[4], vLo[4], vCN[4], vCR[4], vCRLo[4], vGUp[4], vGLo[4], vSm[4], vBehind[4], vSpotUp[4],
+  alignas(16) float vUp[4], vLo[4], vCR[4], vCRLo[4], vGUp[4], vGLo[4], vSm[4], vBehind[4], vSpotUp[4],
       vSpotLo[4];
   _mm_store_ps(vSpotUp, spotUp);
   _mm_store_ps(vSpotLo, spotLo);
   _mm_store_ps(vUp, mUpScale);
   _mm_store_ps(vLo, cNLo);
-  _mm_store_ps(vCN, cN);
   _mm_store_ps(vCR, cRUpSlack);
   _mm_store_ps(vCRLo, cRLo);
   _mm_store_ps(vGUp, gUp);
@@ -193,9 +191,9 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
     }
     uint32_t smoothBits;
     std::memcpy(&smoothBits, &vSm[k], sizeof smoothBits);
-    o.lower = mLo * (vGLo[k] * 0.9999f) * n.intensity;
+    o.lower = mLo * (vGLo[k] * kLowerScale) * n.intensity;
     o.smooth = smoothBits != 0;
-    o.upper = mUp * (vGUp[k] * 1.0001f) * n.intensity;
+    o.upper = mUp * (vGUp[k] * kUpperScale) * n.intensity;
   }
 #else
   for (int k = 0; k < 2; ++k)
