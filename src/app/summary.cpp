@@ -50,6 +50,7 @@ void forEachEvalCounter(S& s, F&& f) {
   f("shadow_rays", s.shadowRays);
   f("bounds_evaluated", s.boundsEvaluated);
   f("reconstructed_points", s.reconstructedPoints);
+  f("reconstructed_rays", s.reconstructedRays);
   f("probed_clusters", s.probedClusters);
   f("probe_rays", s.probeRays);
   f("occluded_rays", s.occludedRays);
@@ -189,6 +190,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["reconstruct_coarse_spacing"] = ro.reconstructCoarseSpacing;
   j["reconstruction_samples"] = rr.stats.reconstructionSamples;
   j["reconstructed_points"] = es.reconstructedPoints;
+  j["reconstructed_shadow_rays"] = es.reconstructedRays;
   j["reconstruction_fallbacks"] = rr.stats.reconstructionFallbacks;
   j["reconstruction_coarse_cells"] = rr.stats.reconstructionCoarseCells;
   j["reconstruct_split"] = ro.reconstructSplit;

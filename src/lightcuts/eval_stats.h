@@ -18,6 +18,7 @@ struct EvalStats {
   uint64_t shadowRays = 0;
   uint64_t boundsEvaluated = 0;
   uint64_t reconstructedPoints = 0;  // shading points given a reconstruction cut
+  uint64_t reconstructedRays = 0;    // the shadow rays those points sent (in shadowRays too)
   uint64_t probedClusters = 0;       // clusters tested for being hidden as a whole
   uint64_t probeRays = 0;            // the shadow rays those tests cast (in shadowRays too)
   uint64_t occludedRays = 0;         // shadow rays that found their light hidden
@@ -59,6 +60,7 @@ struct EvalStats {
     shadowRays += o.shadowRays;
     boundsEvaluated += o.boundsEvaluated;
     reconstructedPoints += o.reconstructedPoints;
+    reconstructedRays += o.reconstructedRays;
     probedClusters += o.probedClusters;
     probeRays += o.probeRays;
     occludedRays += o.occludedRays;

@@ -305,6 +305,7 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
   // rays ahead: scattered over the light array, each was a cache miss); then the batched
   // nodes four at a time, group by group.
   Color total(0);
+  const uint64_t raysBefore = stats.shadowRays;
   constexpr size_t kAhead = 4;
   const std::vector<uint32_t>& rays = cut.rayNodes;
   for (size_t i = 0; i < std::min(kAhead, rays.size()); ++i) __builtin_prefetch(&lights.lights[cut.nodes[rays[i]].rep]);
@@ -354,6 +355,7 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
   uint32_t cutSize = uint32_t(cut.nodes.size()) + cut.occluded;
   stats.recordCut(cutSize);
   ++stats.reconstructedPoints;
+  stats.reconstructedRays += stats.shadowRays - raysBefore;
   return {vmax(total, Color(0)), cutSize};
 }
 
