@@ -588,6 +588,7 @@ class Lightcuts final : public LightEvaluator {
       // Trees with no entries begin where the next one does.
       for (size_t t = forest_.trees.size(); t-- > 0;)
         record->treeBegin[t] = std::min(record->treeBegin[t], record->treeBegin[t + 1]);
+      record->finish();
     }
     stats.recordCut(cutSize);
     return {vmax(total.toFloat(), Color(0)), cutSize};

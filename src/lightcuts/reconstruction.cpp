@@ -28,13 +28,17 @@ template <class Lum>
 void groupProbes(size_t count, Lum lum, std::vector<uint32_t>& probe, std::vector<float>* scale) {
   for (size_t g = 0; g < count; g += MergedCut::kGroupSize) {
     size_t best = g;
-    float sum = 0;
+    float sum = 0, bestLum = lum(g);
     for (size_t i = g; i < std::min(count, g + MergedCut::kGroupSize); ++i) {
-      sum += lum(i);
-      if (lum(i) > lum(best)) best = i;
+      const float l = lum(i);
+      sum += l;
+      if (l > bestLum) {
+        best = i;
+        bestLum = l;
+      }
     }
     probe.push_back(uint32_t(best));
-    if (scale) scale->push_back(lum(best) > 0 ? sum / lum(best) : 0.0f);
+    if (scale) scale->push_back(bestLum > 0 ? sum / bestLum : 0.0f);
   }
 }
 
@@ -69,15 +73,17 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
   out.clear();
   count = std::clamp(count, 0, kMaxSamples);
   // Per sample: how many of its entries before each one are not visible with a
-  // first-order estimate, so that any run of entries can be checked at once.
-  static thread_local std::vector<uint32_t> rough[kMaxSamples];
+  // first-order estimate (CutRecord::rough), so that any run of entries can be checked at once.
+  static thread_local std::vector<uint32_t> counted[kMaxSamples];
+  const uint32_t* rough[kMaxSamples];
   for (int i = 0; i < count; ++i) {
-    const std::vector<uint32_t>& e = samples[i]->entries;
-    rough[i].resize(e.size() + 1);
-    rough[i][0] = 0;
-    for (size_t k = 0; k < e.size(); ++k)
-      rough[i][k + 1] = rough[i][k] + !(CutRecord::visibilityOf(e[k]) == CutVisibility::Visible &&
-                                         CutRecord::firstOrderOf(e[k]));
+    const CutRecord& r = *samples[i];
+    if (r.rough.size() != r.entries.size() + 1) {
+      CutRecord::countRough(r.entries, counted[i]);
+      rough[i] = counted[i].data();
+    } else {
+      rough[i] = r.rough.data();
+    }
   }
   // The samples' spread: the largest distance between two of them, squared.
   float spread2 = 0;
@@ -146,9 +152,13 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         pos = next;
         continue;
       }
-      const LightNode n = tree.node(lights, node);
+      // Only the node's sum, representative and size are needed (and an inner node's box):
+      // a leaf's are read off its light, without building its LightNode.
       const bool leaf = isLeafRef(node);
-      const uint32_t nodeEnd = leaf ? pos + 1 : pos + 2 * n.lights() - 1;
+      const LightNode* inner = leaf ? nullptr : &tree.nodes[node];
+      const uint32_t rep = leaf ? leafLight(node) : inner->rep;
+      const Color intensity = leaf ? leafIntensity(lights.lights[rep]) : inner->intensity;
+      const uint32_t nodeEnd = leaf ? pos + 1 : pos + 2 * inner->lights() - 1;
       bool above = false;
       for (int i = 0; i < count; ++i) {
         if (stateOf(state, i) != kAbove) continue;
@@ -173,7 +183,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         }
         // ... as long as the samples are close together seen from the cluster: the coarser
         // cut was chosen for the sample that kept it.
-        ok = ok && kept && distance2Box(n, samples[0]->point) >= kCoarsenRatio2 * spread2;
+        ok = ok && kept && distance2Box(*inner, samples[0]->point) >= kCoarsenRatio2 * spread2;
         for (int i = 0; i < count && ok; ++i) {
           if (stateOf(state, i) != kAbove) continue;
           const uint32_t* e = samples[i]->entries.data();
@@ -217,7 +227,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       if (count > 0 && occluded == count) {
         ++out.occluded;
         if (tree.type == LightType::Omni || tree.type == LightType::Oriented)
-          out.hidden.push_back(MergedCut::Node{n.intensity, n.rep, true, false, false, 1.0f, t, node});
+          out.hidden.push_back(MergedCut::Node{intensity, rep, true, false, false, 1.0f, t, node});
         continue;
       }
       bool needsRay = occluded > 0 || partial > 0 || visible == 0;
@@ -225,7 +235,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       const float factor = firstOrder == count && exacts > 0 ? factorSum / float(exacts) : 1.0f;
       const bool batched = !needsRay && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
       // The group and the batch wait for the pass below, which fetches the lights ahead.
-      out.nodes.push_back(MergedCut::Node{n.intensity, n.rep, needsRay, batched, disagree, factor, t, node});
+      out.nodes.push_back(MergedCut::Node{intensity, rep, needsRay, batched, disagree, factor, t, node});
     }
   }
   // The representatives' lights are scattered over the light array: a cache miss each when

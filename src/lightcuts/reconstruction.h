@@ -56,6 +56,10 @@ struct CutRecord {
   // correction changes with the point far more slowly than the contribution does.
   std::vector<float> factor;
   std::vector<uint32_t> treeBegin;  // entries of tree t: [treeBegin[t], treeBegin[t + 1])
+  // entries.size() + 1 values: rough[k] = how many entries before entry k are not visible
+  // with a first-order estimate, so that a merge checks any run of entries at once. Filled
+  // by finish(); a record without it has it computed by each merge that uses it.
+  std::vector<uint32_t> rough;
   Vec3 point;                       // the sample's shading point
   bool valid = false;               // false: no cut was recorded (the caller's miss)
 
@@ -64,7 +68,20 @@ struct CutRecord {
     nodes.clear();
     factor.clear();
     treeBegin.clear();
+    rough.clear();
     valid = false;
+  }
+  // Fills `rough` from `entries` (a sample is merged several times: ~7 on average in the
+  // church at 512x512, where counting them at every merge was 13% of the merge's time).
+  void finish() { countRough(entries, rough); }
+  static void countRough(const std::vector<uint32_t>& e, std::vector<uint32_t>& rough) {
+    rough.resize(e.size() + 1);
+    uint32_t n = 0;
+    rough[0] = 0;
+    for (size_t k = 0; k < e.size(); ++k) {
+      n += !(visibilityOf(e[k]) == CutVisibility::Visible && firstOrderOf(e[k]));
+      rough[k + 1] = n;
+    }
   }
   static uint32_t pack(uint32_t preorder, CutVisibility v, bool firstOrder = false) {
     return preorder << 3 | uint32_t(firstOrder) << 2 | uint32_t(v);

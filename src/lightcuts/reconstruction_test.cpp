@@ -368,6 +368,45 @@ TEST(Reconstruction, MergedCutIsAPartitionAccurateAtEverySample) {
   }
 }
 
+// A recorded cut carries its prefix count of rough entries (CutRecord::rough), and a merge
+// of records without it (hand-made ones) counts them itself, to the same merged cut.
+TEST(Reconstruction, RecordedRoughCountsMatchAndMergeTheSameWithout) {
+  Fixture f;
+  const Vec3 ps[4] = {Vec3(-0.2f, 0, -0.2f), Vec3(0.2f, 0, -0.2f), Vec3(-0.2f, 0.3f, 0.2f), Vec3(0.2f, 0.3f, 0.2f)};
+  CutRecord r[4], bare[4];
+  bool someRough = false, someSmooth = false;
+  for (int i = 0; i < 4; ++i) {
+    r[i] = f.record(point(ps[i]), halfBlocked);
+    ASSERT_EQ(r[i].rough.size(), r[i].entries.size() + 1);
+    uint32_t n = 0;
+    for (size_t k = 0; k < r[i].entries.size(); ++k) {
+      EXPECT_EQ(r[i].rough[k], n);
+      const bool smooth = CutRecord::visibilityOf(r[i].entries[k]) == CutVisibility::Visible &&
+                          CutRecord::firstOrderOf(r[i].entries[k]);
+      n += !smooth;
+      (smooth ? someSmooth : someRough) = true;
+    }
+    EXPECT_EQ(r[i].rough.back(), n);
+    bare[i] = r[i];
+    bare[i].rough.clear();
+  }
+  EXPECT_TRUE(someRough && someSmooth);  // both kinds, so the counts matter
+  const CutRecord* withCounts[4] = {&r[0], &r[1], &r[2], &r[3]};
+  const CutRecord* without[4] = {&bare[0], &bare[1], &bare[2], &bare[3]};
+  for (int count = 2; count <= 4; ++count) {
+    MergedCut a, b;
+    f.lc->mergeSamples(withCounts, count, a);
+    f.lc->mergeSamples(without, count, b);
+    ASSERT_EQ(a.nodes.size(), b.nodes.size()) << count;
+    for (size_t k = 0; k < a.nodes.size(); ++k) {
+      EXPECT_EQ(a.nodes[k].node, b.nodes[k].node);
+      EXPECT_EQ(a.nodes[k].needsRay, b.nodes[k].needsRay);
+      EXPECT_EQ(a.nodes[k].factor, b.nodes[k].factor);
+    }
+    EXPECT_EQ(a.occluded, b.occluded);
+  }
+}
+
 }  // namespace
 }  // namespace lc::lightcuts
 
