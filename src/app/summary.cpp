@@ -50,7 +50,7 @@ void forEachEvalCounter(S& s, F&& f) {
   f("shadow_rays", s.shadowRays);
   f("bounds_evaluated", s.boundsEvaluated);
   f("reconstructed_points", s.reconstructedPoints);
-  f("reconstructed_rays", s.reconstructedRays);
+  f("reconstructed_shadow_rays", s.reconstructedRays);
   f("probed_clusters", s.probedClusters);
   f("probe_rays", s.probeRays);
   f("occluded_rays", s.occludedRays);

@@ -148,7 +148,6 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
                            const BoundFrames& fr, Color* lower, bool* smooth = nullptr,
                            const LightGroup* low = nullptr) {
   const LightGroup& gl = low ? *low : g;
-  constexpr float kSlack = kCosSlack;
   if (lower) *lower = Color(0);
   if (smooth) *smooth = false;
   Vec3 lo, hi;  // vectors from the shading point toward the cluster's lights
@@ -166,7 +165,7 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
   if (cN <= 0) return Color(0);  // every light is behind the surface
   CosRange un{1, 0};
   if (directional) {
-    un = unitCosBounds(bn, fr.n.w, node, kSlack);
+    un = unitCosBounds(bn, fr.n.w, node, kCosSlack);
     cN = std::min(cN, un.up);
     if (cN <= 0) return Color(0);
   }
@@ -178,7 +177,7 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
   float cNLo = lower && dMax > 0 ? std::max(0.0f, (bn.cz - bn.hz) / dMax) : 0.0f;
   if (lower && directional) cNLo = std::max(cNLo, un.lo);
   bool specular = !g.diffuseOnly && sp.hasSpecular();
-  Color mUp = sp.kd * std::min(1.0f, cN + kSlack);
+  Color mUp = sp.kd * std::min(1.0f, cN + kCosSlack);
   Color mLo = sp.kd * cNLo;
   // Smooth: the first-order estimate applies (directional: its gradient is over the
   // directions, estimate.h).
@@ -189,10 +188,10 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
     float cRUp = br.cosUpper();
     CosRange ur{1, 0};
     if (directional && cRUp > 0) {
-      ur = unitCosBounds(br, fr.r.w, node, kSlack);
+      ur = unitCosBounds(br, fr.r.w, node, kCosSlack);
       cRUp = std::max(0.0f, std::min(cRUp, ur.up));
     }
-    mUp += sp.ks * powNonNegative(std::min(1.0f, cRUp + kSlack), sp.shininess);
+    mUp += sp.ks * powNonNegative(std::min(1.0f, cRUp + kCosSlack), sp.shininess);
     float cRLo = cNLo > 0 ? std::max(0.0f, (br.cz - br.hz) / dMax) : 0.0f;
     if (cNLo > 0 && directional) cRLo = std::max(cRLo, ur.lo);
     if (cNLo > 0) mLo += sp.ks * powNonNegative(cRLo, sp.shininess);
@@ -219,7 +218,7 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
       // One square root per bound: cheaper than the node's bytes it would take to store.
       const float sinHalfAngle = std::sqrt(std::max(0.0f, 1 - node.cosHalfAngle * node.cosHalfAngle));
       float cUp = std::max(0.0f, coneWiden(cosUp, node.cosHalfAngle, sinHalfAngle));
-      if (cUp > 0) cUp = std::min(1.0f, cUp + kSlack);
+      if (cUp > 0) cUp = std::min(1.0f, cUp + kCosSlack);
       gUp *= type == LightType::Oriented ? cUp : g.falloff(cUp);
       if (lower) {
         // 0 means "may be 90 degrees or more", not a cosine: no lower bound then.
