@@ -23,6 +23,7 @@ struct RenderArgs {
   int aaSamples = render::RenderOptions{}.aaSamples;
   bool aaExtrapolationProbe = render::RenderOptions{}.aaExtrapolationProbe;
   bool aaPixelSamples = render::RenderOptions{}.aaPixelSamples;
+  bool reconstructRefine = render::RenderOptions{}.reconstructRefine;
   std::string aov;  // comma-separated kAovNames
   int threads = 0;
   int maxDepth = 5;

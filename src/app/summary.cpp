@@ -60,6 +60,7 @@ void forEachEvalCounter(S& s, F&& f) {
   f("cuts_at_max_cut", s.cutsAtMaxCut);
   f("group_probes", s.groupProbes);
   f("failed_group_probes", s.failedGroupProbes);
+  f("refuting_group_probes", s.refutingGroupProbes);
   f("traced_rays", s.tracedRays);
   f("timed_rays", s.timedRays);
   f("timed_ray_nanos", s.timedRayNanos);
@@ -79,6 +80,7 @@ nlohmann::json renderCountersJson(const render::RenderStats& st) {
   j["reconstruction_fallbacks"] = st.reconstructionFallbacks;
   j["reconstruction_coarse_cells"] = st.reconstructionCoarseCells;
   j["reconstruction_split_cells"] = st.reconstructionSplitCells;
+  j["reconstruction_refined_cells"] = st.reconstructionRefinedCells;
   j["aa_pixels"] = st.aaPixels;
   j["aa_seam_pixels"] = st.aaSeamPixels;
   j["aa_sub_samples"] = st.aaSubSamples;
@@ -96,6 +98,7 @@ void addRenderCounters(render::RenderStats& st, const nlohmann::json& j) {
   st.reconstructionFallbacks += j.at("reconstruction_fallbacks").get<uint64_t>();
   st.reconstructionCoarseCells += j.at("reconstruction_coarse_cells").get<uint64_t>();
   st.reconstructionSplitCells += j.at("reconstruction_split_cells").get<uint64_t>();
+  st.reconstructionRefinedCells += j.at("reconstruction_refined_cells").get<uint64_t>();
   st.aaPixels += j.at("aa_pixels").get<uint64_t>();
   st.aaSeamPixels += j.at("aa_seam_pixels").get<uint64_t>();
   st.aaSubSamples += j.at("aa_sub_samples").get<uint64_t>();
@@ -186,6 +189,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["cuts_at_max_cut"] = es.cutsAtMaxCut;
   j["group_probes"] = es.groupProbes;
   j["failed_group_probes"] = es.failedGroupProbes;
+  j["refuting_group_probes"] = es.refutingGroupProbes;
   j["reconstruct_spacing"] = ro.reconstructSpacing;
   j["reconstruct_coarse_spacing"] = ro.reconstructCoarseSpacing;
   j["reconstruction_samples"] = rr.stats.reconstructionSamples;
@@ -195,6 +199,8 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["reconstruction_coarse_cells"] = rr.stats.reconstructionCoarseCells;
   j["reconstruct_split"] = ro.reconstructSplit;
   j["reconstruction_split_cells"] = rr.stats.reconstructionSplitCells;
+  j["reconstruct_refine"] = switchName(a.reconstructRefine);
+  j["reconstruction_refined_cells"] = rr.stats.reconstructionRefinedCells;
   j["max_depth"] = a.maxDepth;
   j["tonemap"] = io::toneMapName(a.tonemap);
   j["exposure"] = a.exposure;

@@ -30,6 +30,10 @@ struct EvalStats {
   // Those that found the samples wrong: a group hidden where every sample saw it, or
   // visible where every sample found it occluded (MergedCut::hidden).
   uint64_t failedGroupProbes = 0;
+  // Of those, the ones whose group alone could put the point over the cut's error ratio
+  // (refutingProbeShare): a shadow edge the samples stepped over. Reconstruction refines
+  // there (RenderOptions::reconstructRefine).
+  uint64_t refutingGroupProbes = 0;
   // Time, filled by the caller's Visibility and shading loop where they measure it:
   uint64_t tracedRays = 0;           // rays through the Visibility (shadow and probe rays)
   uint64_t timedRays = 0;            // a random sample of them, timed
@@ -70,6 +74,7 @@ struct EvalStats {
     cutsAtMaxCut += o.cutsAtMaxCut;
     groupProbes += o.groupProbes;
     failedGroupProbes += o.failedGroupProbes;
+    refutingGroupProbes += o.refutingGroupProbes;
     tracedRays += o.tracedRays;
     timedRays += o.timedRays;
     timedRayNanos += o.timedRayNanos;

@@ -278,7 +278,8 @@ class Lightcuts final : public LightEvaluator {
   }
   EvalResult reconstruct(const ShadingPoint& sp, Visibility& vis, EvalStats& stats,
                          const MergedCut& merged) const override {
-    ReconstructionResult r = evaluateMergedCut(lights_, merged, sp, vis, stats, groupProbeShare(opt_.errorRatio));
+    ReconstructionResult r = evaluateMergedCut(lights_, merged, sp, vis, stats, groupProbeShare(opt_.errorRatio),
+                                               refutingProbeShare(opt_.errorRatio));
     return {r.radiance, r.cutSize};
   }
 

@@ -310,7 +310,7 @@ bool probeContradicts(const Vec3& wi, float dist, bool samplesSaw, Visibility& v
 }  // namespace
 
 ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& cut, const ShadingPoint& sp,
-                                       Visibility& vis, EvalStats& stats, float probeShare) {
+                                       Visibility& vis, EvalStats& stats, float probeShare, float refuteShare) {
   // The nodes that need a ray, one by one (their representatives' lights fetched a few
   // rays ahead: scattered over the light array, each was a cache miss); then the batched
   // nodes four at a time, group by group.
@@ -333,7 +333,7 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
   }
   // A group that holds a share of the light worth checking gets its probe's ray; hidden,
   // the group's nodes get one each.
-  const float worth = probeShare * luminance(total);
+  const float worth = probeShare * luminance(total), refuting = refuteShare * luminance(total);
   for (size_t g = 0; g < groups; ++g) {
     if (!(luminance(groupSum[g]) > worth)) continue;
     Color mg;
@@ -342,6 +342,7 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
     if (!repContribution(lights, cut.nodes[cut.groupProbe[g]], sp, mg, wi, dist) ||
         !probeContradicts(wi, dist, true, vis, stats))
       continue;
+    stats.refutingGroupProbes += luminance(groupSum[g]) > refuting;
     total -= groupSum[g];
     for (size_t i = g * MergedCut::kGroupSize; i < std::min(cut.batchNodes.size(), (g + 1) * MergedCut::kGroupSize); ++i)
       total += withRay(lights, cut.nodes[cut.batchNodes[i]], sp, vis, stats);
@@ -350,15 +351,16 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
   // cut's error floor where the point is dark) gets its probe's ray; visible, the group's
   // nodes get one each.
   const float worthHidden = probeShare * std::max(luminance(total), sp.errorFloor);
+  const float refutingHidden = refuteShare * std::max(luminance(total), sp.errorFloor);
   for (size_t g = 0; g < cut.hiddenProbe.size(); ++g) {
     const MergedCut::Node& probe = cut.hidden[cut.hiddenProbe[g]];
     Color mg;
     Vec3 wi;
     float dist;
-    if (!repContribution(lights, probe, sp, mg, wi, dist) ||
-        !(luminance(mg * probe.intensity) * cut.hiddenScale[g] > worthHidden) ||
-        !probeContradicts(wi, dist, false, vis, stats))
-      continue;
+    if (!repContribution(lights, probe, sp, mg, wi, dist)) continue;
+    const float estimate = luminance(mg * probe.intensity) * cut.hiddenScale[g];
+    if (!(estimate > worthHidden) || !probeContradicts(wi, dist, false, vis, stats)) continue;
+    stats.refutingGroupProbes += estimate > refutingHidden;
     for (size_t i = g * MergedCut::kGroupSize; i < std::min(cut.hidden.size(), (g + 1) * MergedCut::kGroupSize); ++i)
       total += withRay(lights, cut.hidden[i], sp, vis, stats);
   }

@@ -163,10 +163,19 @@ struct ReconstructionResult {
 // edge pixels 10-20% over at 512x512; docs/LIGHTCUTS.md, "Group probes".)
 inline float groupProbeShare(float errorRatio) { return 0.5f * errorRatio; }
 
+// The share of a point's light above which a failed group probe refutes its samples
+// (EvalStats::refutingGroupProbes): the cut's error ratio. Such a group alone puts the
+// point over --error; the point re-traces it, but its neighbours, whose probes went to
+// other lights of the group or who had none, borrow the same wrong visibility, so the
+// image's reconstruction refines where one is found (RenderOptions::reconstructRefine).
+inline float refutingProbeShare(float errorRatio) { return errorRatio; }
+
 // Direct light at `sp` over a merged cut. Shadow rays go through `vis`; shadow rays and
 // the cut are counted in `stats`. A group of borrowed-visible nodes that holds more than
-// `probeShare` of the point's light gets a probe ray (groupProbeShare).
+// `probeShare` of the point's light gets a probe ray (groupProbeShare); a failed probe
+// whose group holds more than `refuteShare` counts in stats.refutingGroupProbes
+// (refutingProbeShare).
 ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& cut, const ShadingPoint& sp,
-                                       Visibility& vis, EvalStats& stats, float probeShare);
+                                       Visibility& vis, EvalStats& stats, float probeShare, float refuteShare);
 
 }  // namespace lc::lightcuts

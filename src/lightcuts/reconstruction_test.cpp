@@ -192,7 +192,7 @@ TEST(Reconstruction, AHiddenGroupIsCaughtWhenItHoldsMoreThanTheProbeShare) {
   ASSERT_GE(m.groupProbe.size(), 2u);
   CountingVisibility all(open);
   EvalStats st;
-  const float total = luminance(evaluateMergedCut(f.lights, m, sp, all, st, 0.0f).radiance);
+  const float total = luminance(evaluateMergedCut(f.lights, m, sp, all, st, 0.0f, 0.0f).radiance);
   // The dimmest group with some light: the one a thin shadow hides.
   constexpr size_t kBlocks = MergedCut::kGroupSize / 4;
   size_t hiddenGroup = 0;
@@ -214,15 +214,25 @@ TEST(Reconstruction, AHiddenGroupIsCaughtWhenItHoldsMoreThanTheProbeShare) {
       if (dot(wi, d) > 0.99999f) return Color(0);
     return Color(1);
   };
-  auto evaluate = [&](float probeShare, EvalStats& s) {
+  auto evaluate = [&](float probeShare, EvalStats& s, float refuteShare = 1.0f) {
     CountingVisibility v(shadowed);
-    return luminance(evaluateMergedCut(f.lights, m, sp, v, s, probeShare).radiance);
+    return luminance(evaluateMergedCut(f.lights, m, sp, v, s, probeShare, refuteShare).radiance);
   };
   EvalStats caught, missed;
   EXPECT_NEAR(evaluate(0.99f * share, caught), total - groupLight, 1e-3f * total);
   EXPECT_GE(caught.failedGroupProbes, 1u);
+  EXPECT_EQ(caught.refutingGroupProbes, 0u);  // the group holds less than the refuting share
   EXPECT_NEAR(evaluate(1.01f * share, missed), total, 1e-4f * total);
   EXPECT_EQ(missed.failedGroupProbes, 0u);
+  // The failed probe refutes the samples when its group holds more than the refuting
+  // share of the point's light (measured before the group was taken out), and only then.
+  EvalStats refuted, notRefuted;
+  evaluate(0.5f * share, refuted, 0.99f * share);
+  EXPECT_GE(refuted.refutingGroupProbes, 1u);
+  evaluate(0.5f * share, notRefuted, 1.01f * share);
+  EXPECT_GE(notRefuted.failedGroupProbes, 1u);
+  EXPECT_EQ(notRefuted.refutingGroupProbes, 0u);
+  EXPECT_EQ(refutingProbeShare(0.02f), 0.02f);
   // Through the evaluator, at its error ratio: caught when the group holds over half of it.
   EXPECT_EQ(groupProbeShare(0.02f), 0.01f);
   CountingVisibility v(shadowed);
@@ -260,13 +270,14 @@ TEST(Reconstruction, AGroupTheSamplesFoundHiddenButThePointSeesIsCaught) {
   };
   auto evaluate = [&](float probeShare, EvalStats& s) {
     CountingVisibility v(seen);
-    return luminance(evaluateMergedCut(f.lights, m, sp, v, s, probeShare).radiance);
+    return luminance(evaluateMergedCut(f.lights, m, sp, v, s, probeShare, 0.0f).radiance);
   };
   EvalStats missed, caught;
   const float without = evaluate(1e30f, missed);  // no group probed
   EXPECT_EQ(missed.groupProbes, 0u);
   EXPECT_NEAR(evaluate(0.0f, caught), without + gapLight, 1e-3 * (without + gapLight));
   EXPECT_GE(caught.failedGroupProbes, 1u);
+  EXPECT_GE(caught.refutingGroupProbes, 1u);  // any share refutes at a refuting share of 0
 }
 
 TEST(Reconstruction, SamplesThatDisagreeSendTheRayAndAgreeingOnesDoNot) {

@@ -315,6 +315,34 @@ TEST(Accuracy, CellsSplitWhereTheirSamplesDisagreeCatchShadowsBetweenThem) {
   for (uint8_t d : split.done) ASSERT_EQ(d, 1);
 }
 
+// The same striped floor with cells that never split for disagreeing: there a point's group
+// probe finds a shadow its corners stepped over, and with RenderOptions::reconstructRefine
+// its cell splits (new samples nearer its pixels) where without it only that point
+// re-traces the group and its neighbours keep the corners' wrong visibility.
+TEST(Accuracy, CellsRefineWhereAProbeRefutesTheirSamples) {
+  Evaluated e(slatFloor(5, 400));
+  const scene::Scene* s = e.scene.get();
+  const lightcuts::LightEvaluator *brute = e.brute.get(), *lc = e.lc.get();
+  RenderOptions o;
+  o.aa = AntiAliasing::Off;
+  o.width = o.height = 64;
+  o.reconstructSpacing = 4;
+  o.reconstructSplit = 1;
+  RenderResult ref = render(*s, *brute, o);
+  o.reconstructRefine = false;
+  RenderResult off = render(*s, *lc, o);
+  o.reconstructRefine = true;
+  RenderResult on = render(*s, *lc, o);
+  const io::ImageMetrics moff = io::compareImages(ref.image, off.image), mon = io::compareImages(ref.image, on.image);
+  EXPECT_EQ(off.stats.reconstructionRefinedCells, 0u);
+  EXPECT_GT(off.stats.eval.refutingGroupProbes, 0u);
+  EXPECT_GT(on.stats.reconstructionRefinedCells, 0u);
+  EXPECT_GT(on.stats.reconstructionSamples, off.stats.reconstructionSamples);
+  EXPECT_LT(mon.fraction_over_threshold, 0.7 * moff.fraction_over_threshold)
+      << "off " << moff.fraction_over_threshold << " on " << mon.fraction_over_threshold;
+  for (uint8_t d : on.done) ASSERT_EQ(d, 1);
+}
+
 // A fence of `boards` upright boards (thickness x height x 3), `pitch` apart and centred,
 // standing on a floor seen from above, lit by 300 low point lights on both sides.
 std::string fenceScene(int boards, float pitch, float thickness, float height) {

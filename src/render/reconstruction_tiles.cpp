@@ -115,7 +115,24 @@ EvalResult PrimaryHook::light(const Hit& h, const ShadingPoint& sp, lightcuts::V
     cuts->merge(sampleCuts, k, cell->merged[mask]);
     cell->ready[mask] = true;
   }
-  return cuts->rebuild(sp, vis, stats, cell->merged[mask]);
+  const uint64_t refuting = stats.refutingGroupProbes;
+  EvalResult r = cuts->rebuild(sp, vis, stats, cell->merged[mask]);
+  if (!(refine && preselected && stats.refutingGroupProbes != refuting)) return r;
+  // A sub-sample whose probe refutes its samples: a full cut, which the sub-samples after
+  // it may borrow (a cell's pixels are refined by ReconstructionTile::cellPixels instead).
+  ++fallbacks;
+  if (!aaCache) return cuts->full(sp, vis, stats);
+  PixelSamples& own = aaCache->pixelSamples;
+  const int i = own.recorded++ % PixelSamples::kMax;
+  CutSample* s = &own.slot[i];
+  aaCache->forget(s);
+  s->cut.clear();
+  own.px[i] = px;
+  own.py[i] = py;
+  s->shape = h.shape;
+  s->p = h.p;
+  s->n = h.ns;
+  return cuts->record(sp, vis, stats, s->cut);
 }
 
 EdgeSamples::EdgeSamples(int width, int height, int tile)
@@ -310,8 +327,14 @@ void ReconstructionTile::cellPixels(int cx, int cy, int w, int h) {
   }
   bool left = split;  // pixels this cell's samples cannot serve
   n_.coarseCells += coarse && !split;
-  for (int y = cy; y < cy + h && !split; ++y)
-    for (int x = cx; x < cx + w; ++x) {
+  // A probe that refutes the corners (RenderOptions::reconstructRefine) stops the cell: its
+  // pixels wait for smaller cells, with samples nearer them, those it rebuilt included.
+  const bool refine = o_.reconstructRefine && (w > 1 || h > 1);
+  const uint64_t refuting = n_.stats.refutingGroupProbes;
+  auto refuted = [&] { return refine && n_.stats.refutingGroupProbes != refuting; };
+  scratch_.rebuilt.clear();
+  for (int y = cy; y < cy + h && !split && !refuted(); ++y)
+    for (int x = cx; x < cx + w && !refuted(); ++x) {
       uint8_t& st = scratch_.state[slot(x, y)];
       if (st & kDone) continue;
       if (o_.cancel && o_.cancel->load(std::memory_order_relaxed)) return;
@@ -330,7 +353,13 @@ void ReconstructionTile::cellPixels(int cx, int cy, int w, int h) {
                  renderPixel(r_.scene, r_.ev, o_, x, y, n_.stats, n_.primary, n_.secondary, &hook));
       n_.fallbacks += hook.fallbacks;
       st |= kDone;
+      if (refine) scratch_.rebuilt.push_back(uint32_t(slot(x, y)));
     }
+  if (refuted()) {
+    for (uint32_t s : scratch_.rebuilt) scratch_.state[s] &= uint8_t(~kDone);
+    ++n_.refinedCells;
+    left = true;
+  }
   if (!left) return;
   int w0 = w > 1 ? w / 2 : w, h0 = h > 1 ? h / 2 : h;
   cellPixels(cx, cy, w0, h0);
@@ -382,6 +411,8 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
   hook.px = x * kSub + std::min(kSub - 1, int(u.x * float(kSub)));
   hook.py = y * kSub + std::min(kSub - 1, int(u.y * float(kSub)));
   hook.preselected = true;
+  hook.refine = o_.reconstructRefine;
+  if (o_.aaPixelSamples) hook.aaCache = &cache;
   Hit hit;
   if (r_.scene.intersect(ray, hit)) {
     const float far2 = length2(hit.p - cam.eye) * maxSeparation_ * maxSeparation_;

@@ -176,6 +176,11 @@ struct PrimaryHook final : PrimaryLight {
   int cx[4] = {}, cy[4] = {};  // the samples' pixels
   bool preselected = false;  // samples chosen for this very hit (antialiasing): no hull test
   bool recordFallback = false;  // `record` is a pixel sample (PixelSamples): count it a fallback
+  // Antialiasing's sub-samples (preselected) under RenderOptions::reconstructRefine: a
+  // sub-sample whose probe refutes its samples takes a full cut, recorded as a pixel sample
+  // in this cache when there is one.
+  bool refine = false;
+  AaCutCache* aaCache = nullptr;
   uint64_t fallbacks = 0;  // hits no sample could serve: they got a full lightcut
   uint64_t separationRays = 0;  // antialiasing: rays that tested its samples for being cut off,
                                 // and for a surface near the sub-sample beyond their hull
@@ -247,6 +252,7 @@ struct ReconstructionScratch {
   std::vector<uint8_t> state;            // per slot: ReconstructionTile::kDone when its pixel is stored
   std::vector<const CutSample*> shared;  // per slot: its sample (the slot's, or an EdgeSamples one), once made
   CellCuts cell;                         // the merged cuts of the current cell
+  std::vector<uint32_t> rebuilt;         // the slots of the pixels the current cell rebuilt
 };
 
 // One tile under reconstruction cuts. The tile is cut into cells of S x S pixels with
@@ -256,7 +262,8 @@ struct ReconstructionScratch {
 // single pixels: samples gather along edges and silhouettes, smooth regions share a few
 // (the adaptive image sampling of Walter et al. 2005, sec. 5). A cell also splits where
 // its corners disagree about much of their light (RenderOptions::reconstructSplit), so
-// samples gather where shadow edges are dense too. Every choice depends only
+// samples gather where shadow edges are dense too, and where a point's probe finds a shadow
+// edge its corners stepped over (RenderOptions::reconstructRefine). Every choice depends only
 // on the hits, so the image does not depend on the order tiles run in. Corners on the
 // tile's right and bottom edges belong to the next tiles; they are shared with them
 // (EdgeSamples) and stored by the tile they belong to.

@@ -254,6 +254,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
     res.stats.reconstructionFallbacks += n.fallbacks;
     res.stats.reconstructionCoarseCells += n.coarseCells;
     res.stats.reconstructionSplitCells += n.splitCells;
+    res.stats.reconstructionRefinedCells += n.refinedCells;
     res.stats.tiles += n.tiles;
     res.stats.pixels += n.pixels;
     res.stats.aaPixels += n.aaPixels;

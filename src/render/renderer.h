@@ -114,6 +114,19 @@ struct RenderOptions {
   // to +7%, render time +4% to +19% (docs/BENCHMARKS.md, "Cells split where their samples
   // disagree").
   float reconstructSplit = 0.2f;
+  // Reconstruction cuts: where a rebuilt point's group probe finds a group of its light
+  // hidden that every sample saw (or lit that every sample found hidden), and the group
+  // alone could put the point over --error (lightcuts::refutingProbeShare), the samples
+  // stepped over a shadow edge: the point's cell splits in four, with new samples at the
+  // parts' corners (the points it had rebuilt are rebuilt again from the nearer samples),
+  // and an antialiasing sub-sample takes a full cut, recorded as a sample for the rest of
+  // its pixel (with aaPixelSamples). The point itself re-traces the group either way; its
+  // neighbours, whose probes went to other lights or who had none, would not. On by
+  // default: unseen warehouses of thin shelves (scripts/gen_warehouse.py, 512 x 512) from
+  // 0.51% to 0.22-0.24% of pixels over 2%, blinds 0.51% -> 0.22%, for 4-7% more shadow
+  // rays; the church +9% rays, 3-10% time (docs/LIGHTCUTS.md, "Probes that refute their
+  // samples").
+  bool reconstructRefine = true;
   // Antialiasing under reconstruction cuts: a sub-sample whose samples include one cut off
   // from it by another surface (one occlusion ray per sample, counted as a shadow ray) takes
   // a full cut instead of borrowing (ReconstructionTile::subSampleHook). On by default: a
@@ -190,6 +203,7 @@ struct RenderStats {
   uint64_t reconstructionFallbacks = 0;  // primary hits whose samples did not match: full cuts
   uint64_t reconstructionCoarseCells = 0;  // cells of reconstructCoarseSpacing kept whole
   uint64_t reconstructionSplitCells = 0;   // cells split for their samples' disagreement (reconstructSplit)
+  uint64_t reconstructionRefinedCells = 0;  // cells split for a refuting group probe (reconstructRefine)
   uint64_t secondaryRays = 0;  // reflection and refraction
   uint64_t aaPixels = 0;       // pixels re-sampled by adaptive antialiasing
   uint64_t aaSeamPixels = 0;   // of them, those flagged across tile borders (seamPixels)

@@ -114,6 +114,7 @@ struct TileCounters {
   uint64_t fallbacks = 0;               // primary hits no sample could serve: full lightcuts
   uint64_t coarseCells = 0;             // coarse reconstruction cells kept whole
   uint64_t splitCells = 0;              // cells of the spacing or less split for disagreement
+  uint64_t refinedCells = 0;            // cells split for a refuting group probe
   uint64_t tiles = 0, pixels = 0;
   uint64_t aaPixels = 0, aaSubSamples = 0;  // adaptive antialiasing's pixels and their rays
 };
