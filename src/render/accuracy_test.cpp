@@ -293,19 +293,24 @@ std::string slatFloor(uint32_t seed, int lights) {
   return t;
 }
 
-TEST(Accuracy, CellsSplitWhereTheirSamplesDisagreeCatchShadowsBetweenThem) {
-  Evaluated e(slatFloor(5, 400));
-  const scene::Scene* s = e.scene.get();
-  const lightcuts::LightEvaluator *brute = e.brute.get(), *lc = e.lc.get();
+// The striped floor's options: pixel centres, 64 x 64, samples every 4 pixels.
+RenderOptions slatFloorOptions() {
   RenderOptions o;
   o.aa = AntiAliasing::Off;
   o.width = o.height = 64;
   o.reconstructSpacing = 4;
-  RenderResult ref = render(*s, *brute, o);
+  return o;
+}
+
+TEST(Accuracy, CellsSplitWhereTheirSamplesDisagreeCatchShadowsBetweenThem) {
+  Evaluated e(slatFloor(5, 400));
+  RenderOptions o = slatFloorOptions();
+  o.reconstructRefine = false;  // the disagreement alone
+  RenderResult ref = render(*e.scene, *e.brute, o);
   o.reconstructSplit = 1;  // never split: the stripes between samples are missed
-  RenderResult whole = render(*s, *lc, o);
+  RenderResult whole = render(*e.scene, *e.lc, o);
   o.reconstructSplit = RenderOptions{}.reconstructSplit;
-  RenderResult split = render(*s, *lc, o);
+  RenderResult split = render(*e.scene, *e.lc, o);
   const io::ImageMetrics mw = io::compareImages(ref.image, whole.image), ms = io::compareImages(ref.image, split.image);
   EXPECT_EQ(whole.stats.reconstructionSplitCells, 0u);
   EXPECT_GT(split.stats.reconstructionSplitCells, 0u);
@@ -321,18 +326,13 @@ TEST(Accuracy, CellsSplitWhereTheirSamplesDisagreeCatchShadowsBetweenThem) {
 // re-traces the group and its neighbours keep the corners' wrong visibility.
 TEST(Accuracy, CellsRefineWhereAProbeRefutesTheirSamples) {
   Evaluated e(slatFloor(5, 400));
-  const scene::Scene* s = e.scene.get();
-  const lightcuts::LightEvaluator *brute = e.brute.get(), *lc = e.lc.get();
-  RenderOptions o;
-  o.aa = AntiAliasing::Off;
-  o.width = o.height = 64;
-  o.reconstructSpacing = 4;
+  RenderOptions o = slatFloorOptions();
   o.reconstructSplit = 1;
-  RenderResult ref = render(*s, *brute, o);
+  RenderResult ref = render(*e.scene, *e.brute, o);
   o.reconstructRefine = false;
-  RenderResult off = render(*s, *lc, o);
+  RenderResult off = render(*e.scene, *e.lc, o);
   o.reconstructRefine = true;
-  RenderResult on = render(*s, *lc, o);
+  RenderResult on = render(*e.scene, *e.lc, o);
   const io::ImageMetrics moff = io::compareImages(ref.image, off.image), mon = io::compareImages(ref.image, on.image);
   EXPECT_EQ(off.stats.reconstructionRefinedCells, 0u);
   EXPECT_GT(off.stats.eval.refutingGroupProbes, 0u);
