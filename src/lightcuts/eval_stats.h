@@ -58,6 +58,21 @@ struct EvalStats {
     while (b + 1 < kHistogramBuckets && (uint64_t(1) << b) <= size) ++b;
     ++cutHistogram[size_t(b)];
   }
+  // The counts of points and their cuts, apart from the work. Points whose results are
+  // thrown away (where a reconstruction refines: RenderOptions::reconstructRefine) are
+  // taken back out of them, their work (rays, bounds) staying counted, so per-point
+  // figures divide all the work by the points of the image.
+  struct PointCounts {
+    uint64_t shadingPoints, reconstructedPoints, cutNodes;
+    std::array<uint64_t, kHistogramBuckets> cutHistogram;
+  };
+  PointCounts pointCounts() const { return {shadingPoints, reconstructedPoints, cutNodes, cutHistogram}; }
+  void restorePointCounts(const PointCounts& c) {
+    shadingPoints = c.shadingPoints;
+    reconstructedPoints = c.reconstructedPoints;
+    cutNodes = c.cutNodes;
+    cutHistogram = c.cutHistogram;
+  }
   void add(const EvalStats& o) {
     shadingPoints += o.shadingPoints;
     cutNodes += o.cutNodes;

@@ -116,10 +116,12 @@ EvalResult PrimaryHook::light(const Hit& h, const ShadingPoint& sp, lightcuts::V
     cell->ready[mask] = true;
   }
   const uint64_t refuting = stats.refutingGroupProbes;
+  const EvalStats::PointCounts points = stats.pointCounts();
   EvalResult r = cuts->rebuild(sp, vis, stats, cell->merged[mask]);
   if (!(refine && preselected && stats.refutingGroupProbes != refuting)) return r;
   // A sub-sample whose probe refutes its samples: a full cut, which the sub-samples after
   // it may borrow (a cell's pixels are refined by ReconstructionTile::cellPixels instead).
+  stats.restorePointCounts(points);
   ++fallbacks;
   if (!aaCache) return cuts->full(sp, vis, stats);
   PixelSamples& own = aaCache->pixelSamples;
@@ -331,6 +333,7 @@ void ReconstructionTile::cellPixels(int cx, int cy, int w, int h) {
   // pixels wait for smaller cells, with samples nearer them, those it rebuilt included.
   const bool refine = o_.reconstructRefine && (w > 1 || h > 1);
   const uint64_t refuting = n_.stats.refutingGroupProbes;
+  const EvalStats::PointCounts points = n_.stats.pointCounts();
   auto refuted = [&] { return refine && n_.stats.refutingGroupProbes != refuting; };
   scratch_.rebuilt.clear();
   for (int y = cy; y < cy + h && !split && !refuted(); ++y)
@@ -356,6 +359,7 @@ void ReconstructionTile::cellPixels(int cx, int cy, int w, int h) {
       if (refine) scratch_.rebuilt.push_back(uint32_t(slot(x, y)));
     }
   if (refuted()) {
+    n_.stats.restorePointCounts(points);
     for (uint32_t s : scratch_.rebuilt) scratch_.state[s] &= uint8_t(~kDone);
     ++n_.refinedCells;
     left = true;

@@ -123,8 +123,8 @@ struct RenderOptions {
   // its pixel (with aaPixelSamples). The point itself re-traces the group either way; its
   // neighbours, whose probes went to other lights or who had none, would not. On by
   // default: unseen warehouses of thin shelves (scripts/gen_warehouse.py, 512 x 512) from
-  // 0.51% to 0.22-0.24% of pixels over 2%, blinds 0.51% -> 0.22%, for 4-7% more shadow
-  // rays; the church +9% rays, 3-10% time (docs/LIGHTCUTS.md, "Probes that refute their
+  // 0.51% to 0.22-0.24% of pixels over 2%, blinds 0.51% -> 0.22%, for 5-10% more shadow
+  // rays; the church +11% rays, 3-10% time (docs/LIGHTCUTS.md, "Probes that refute their
   // samples").
   bool reconstructRefine = true;
   // Antialiasing under reconstruction cuts: a sub-sample whose samples include one cut off
