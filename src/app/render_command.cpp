@@ -700,7 +700,7 @@ void addRenderCommand(CLI::App& app) {
             fmt::format("Reconstruction cuts: where a point's probe finds hidden a group of lights holding over "
                         "--error of its light that all its samples saw (a shadow they stepped over), its cell splits "
                         "in four with new samples, and an antialiasing sub-sample takes a full lightcut (thin shelves "
-                        "and posts: fewer pixels over --error, ~5-10% more shadow rays); off, only that point "
+                        "and posts: fewer pixels over --error, 5-11% more shadow rays); off, only that point "
                         "re-traces the group; default {}",
                         switchName(d.reconstructRefine)))
       ->group(recon);
