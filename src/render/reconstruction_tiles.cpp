@@ -36,6 +36,17 @@ void AaCutCache::forget(const CutSample* s) {
     if (e.aaCount > 0 && std::find(e.aaSamples, e.aaSamples + e.aaCount, s) != e.aaSamples + e.aaCount) e.reset();
 }
 
+CutSample* AaCutCache::newPixelSample(int px, int py) {
+  PixelSamples& own = pixelSamples;
+  const int i = own.recorded++ % PixelSamples::kMax;
+  CutSample* s = &own.slot[i];
+  forget(s);
+  s->cut.clear();
+  own.px[i] = px;
+  own.py[i] = py;
+  return s;
+}
+
 CellCuts* AaCutCache::find(const CutSample* const* set, int k) {
   for (CellCuts& e : entries)
     if (e.aaCount == k && std::equal(set, set + k, e.aaSamples)) return &e;
@@ -95,12 +106,16 @@ unsigned servingSamples(const PrimaryHook& h, int shape, const Vec3& p, const Ve
 }
 
 EvalResult PrimaryHook::light(const Hit& h, const ShadingPoint& sp, lightcuts::Visibility& vis, EvalStats& stats) {
+  // A full cut recorded as sample s.
+  auto recordInto = [&](CutSample* s) {
+    s->shape = h.shape;
+    s->p = h.p;
+    s->n = h.ns;
+    return cuts->record(sp, vis, stats, s->cut);
+  };
   if (record) {
     fallbacks += recordFallback;
-    record->shape = h.shape;
-    record->p = h.p;
-    record->n = h.ns;
-    return cuts->record(sp, vis, stats, record->cut);
+    return recordInto(record);
   }
   const lightcuts::CutRecord* sampleCuts[4];
   int k = 0;
@@ -118,23 +133,12 @@ EvalResult PrimaryHook::light(const Hit& h, const ShadingPoint& sp, lightcuts::V
   const uint64_t refuting = stats.refutingGroupProbes;
   const EvalStats::PointCounts points = stats.pointCounts();
   EvalResult r = cuts->rebuild(sp, vis, stats, cell->merged[mask]);
-  if (!(refine && preselected && stats.refutingGroupProbes != refuting)) return r;
+  if (!(refine && stats.refutingGroupProbes != refuting)) return r;
   // A sub-sample whose probe refutes its samples: a full cut, which the sub-samples after
   // it may borrow (a cell's pixels are refined by ReconstructionTile::cellPixels instead).
   stats.restorePointCounts(points);
   ++fallbacks;
-  if (!aaCache) return cuts->full(sp, vis, stats);
-  PixelSamples& own = aaCache->pixelSamples;
-  const int i = own.recorded++ % PixelSamples::kMax;
-  CutSample* s = &own.slot[i];
-  aaCache->forget(s);
-  s->cut.clear();
-  own.px[i] = px;
-  own.py[i] = py;
-  s->shape = h.shape;
-  s->p = h.p;
-  s->n = h.ns;
-  return cuts->record(sp, vis, stats, s->cut);
+  return aaCache ? recordInto(aaCache->newPixelSample(px, py)) : cuts->full(sp, vis, stats);
 }
 
 EdgeSamples::EdgeSamples(int width, int height, int tile)
@@ -498,13 +502,7 @@ void ReconstructionTile::subSampleHook(const Ray& ray, int x, int y, Vec2 u, Pri
     }
     // A full cut: recorded as a pixel sample (over the oldest, once all kMax are taken).
     if (hook.count == 0 && o_.aaPixelSamples) {
-      const int i = own.recorded++ % PixelSamples::kMax;
-      CutSample* s = &own.slot[i];
-      cache.forget(s);
-      s->cut.clear();
-      own.px[i] = hook.px;
-      own.py[i] = hook.py;
-      hook.record = s;
+      hook.record = cache.newPixelSample(hook.px, hook.py);
       hook.recordFallback = true;
     }
   }

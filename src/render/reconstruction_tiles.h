@@ -160,6 +160,9 @@ struct AaCutCache {
   CellCuts* find(const CutSample* const* set, int k);
   // Drops the merged cuts that use `s` (a pixel sample about to be recorded anew).
   void forget(const CutSample* s);
+  // The slot for a new pixel sample at (px, py) (the hull test's sub-pixel units), over the
+  // oldest once all PixelSamples::kMax are taken: emptied, its merged cuts forgotten.
+  CutSample* newPixelSample(int px, int py);
 };
 
 // What happens at a primary hit under reconstruction cuts: the hit records its lightcut as
@@ -176,9 +179,9 @@ struct PrimaryHook final : PrimaryLight {
   int cx[4] = {}, cy[4] = {};  // the samples' pixels
   bool preselected = false;  // samples chosen for this very hit (antialiasing): no hull test
   bool recordFallback = false;  // `record` is a pixel sample (PixelSamples): count it a fallback
-  // Antialiasing's sub-samples (preselected) under RenderOptions::reconstructRefine: a
-  // sub-sample whose probe refutes its samples takes a full cut, recorded as a pixel sample
-  // in this cache when there is one.
+  // Antialiasing's sub-samples under RenderOptions::reconstructRefine: a sub-sample whose
+  // probe refutes its samples takes a full cut, recorded as a pixel sample in this cache
+  // when there is one.
   bool refine = false;
   AaCutCache* aaCache = nullptr;
   uint64_t fallbacks = 0;  // hits no sample could serve: they got a full lightcut
