@@ -93,6 +93,14 @@ TileRect TileGrid::rect(int t) const {
   return {tx * tile, ty * tile, std::min(width, (tx + 1) * tile), std::min(height, (ty + 1) * tile)};
 }
 
+// Tiles of reconstruction cuts are about this many pixels wide (whole cells): a tile
+// shares the samples on its border with its neighbours, and its sub-samples borrow only
+// within it, so larger tiles recompute fewer samples.
+constexpr int kReconstructionTile = 64;
+// Tiles an image under reconstruction cuts is cut into at least, where its cells allow:
+// enough to keep every thread of a small machine busy to the end.
+constexpr int64_t kMinTiles = 16;
+
 TileGrid tileGrid(const RenderOptions& o, const LightEvaluator& evaluator) {
   const int S = o.reconstructSpacing;
   const bool recon = S > 1 && evaluator.supportsReconstruction();
@@ -100,7 +108,12 @@ TileGrid tileGrid(const RenderOptions& o, const LightEvaluator& evaluator) {
   TileGrid g;
   g.width = o.width;
   g.height = o.height;
-  g.tile = recon ? (64 + C - 1) / C * C : 16;
+  g.tile = recon ? (kReconstructionTile + C - 1) / C * C : 16;
+  // A small image under reconstruction cuts would be a tile or four, rendered by one or
+  // two threads: its tiles shrink (whole cells still) until there are kMinTiles of them.
+  // From the image's size alone, so the grid is the same whatever the thread count.
+  auto count = [&](int t) { return int64_t((o.width + t - 1) / t) * int64_t((o.height + t - 1) / t); };
+  while (recon && count(g.tile) < kMinTiles && g.tile / 2 >= C && g.tile / 2 % C == 0) g.tile /= 2;
   g.tilesX = (o.width + g.tile - 1) / g.tile;
   g.tilesY = (o.height + g.tile - 1) / g.tile;
   return g;

@@ -228,6 +228,52 @@ translate(0, 0.5, 0, sphere { material = { diffuse = (0.7, 0.2, 0.2); specular =
   for (size_t i = 0; i < a.image.pixels.size(); ++i) ASSERT_EQ(a.image.pixels[i], b.image.pixels[i]) << i;
 }
 
+// Under reconstruction cuts a tile is whole cells of about 64 pixels; a small image was
+// one tile (a 64 x 64 render ran on one thread). Its tiles now shrink, whole cells still,
+// until there are 16 of them, from the image's size alone: the same image at any thread count.
+TEST(Tiles, SmallImagesUnderReconstructionGetEnoughTilesForEveryThread) {
+  auto s = sceneFrom(R"(SBT-raytracer 1.0
+camera { position = (0, 1, 6); viewdir = (0, -0.2, -1); updir = (0, 1, 0); }
+point_light { position = (2, 3, 2); colour = (1, 1, 1); constant_attenuation_coeff = 1; quadratic_attenuation_coeff = 0; }
+point_light { position = (-2, 2, 3); colour = (0.5, 0.6, 1); constant_attenuation_coeff = 1; quadratic_attenuation_coeff = 0; }
+point_light { position = (0, 4, -1); colour = (1, 0.8, 0.5); constant_attenuation_coeff = 1; quadratic_attenuation_coeff = 0; }
+scale(10, rotate(1, 0, 0, -1.5707963, square { material = { diffuse = (0.8, 0.8, 0.8); }; }))
+translate(0, 0.5, 0, sphere { material = { diffuse = (0.7, 0.2, 0.2); }; })
+)");
+  auto forest = lightcuts::buildLightForest(s->lights());
+  auto lc = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
+  auto brute = lightcuts::makeBruteForce(s->lights());
+  auto grid = [&](const lightcuts::LightEvaluator& ev, int w, int h, int spacing, int coarse) {
+    RenderOptions o;
+    o.width = w;
+    o.height = h;
+    o.reconstructSpacing = spacing;
+    o.reconstructCoarseSpacing = coarse;
+    return tileGrid(o, ev);
+  };
+  const TileGrid small = grid(*lc, 64, 64, 2, 4);
+  EXPECT_GE(small.count(), 16);
+  EXPECT_EQ(small.tile % 4, 0);  // whole coarse cells
+  const TileGrid tiny = grid(*lc, 24, 20, 4, 8);  // cells of 8 allow no more than 3 x 3
+  EXPECT_EQ(tiny.tile, 8);
+  EXPECT_EQ(grid(*lc, 512, 512, 4, 8).tile, 64);   // large images keep their tiles
+  EXPECT_EQ(grid(*brute, 64, 64, 2, 4).tile, 16);  // no reconstruction: tiles of 16
+
+  auto renderAt = [&](int threads) {
+    RenderOptions o;
+    o.width = 48;
+    o.height = 40;
+    o.threads = threads;
+    o.reconstructSpacing = 2;
+    o.reconstructCoarseSpacing = 4;
+    return render(*s, *lc, o);
+  };
+  RenderResult a = renderAt(1), b = renderAt(2);
+  EXPECT_GT(a.stats.eval.reconstructedPoints, 0u);
+  ASSERT_EQ(a.image.pixels.size(), b.image.pixels.size());
+  for (size_t i = 0; i < a.image.pixels.size(); ++i) ASSERT_EQ(a.image.pixels[i], b.image.pixels[i]) << i;
+}
+
 TEST(Renderer, CancelledRenderIsMarkedInterrupted) {
   auto s = sceneFrom(kPlaneScene);
   auto ev = lightcuts::makeBruteForce(s->lights());
