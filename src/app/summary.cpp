@@ -52,6 +52,7 @@ void forEachEvalCounter(S& s, F&& f) {
   f("reconstructed_points", s.reconstructedPoints);
   f("reconstructed_shadow_rays", s.reconstructedRays);
   f("probed_clusters", s.probedClusters);
+  f("probes_ruled_out", s.probesRuledOut);
   f("probe_rays", s.probeRays);
   f("occluded_rays", s.occludedRays);
   f("hidden_clusters", s.hiddenClusters);
@@ -180,6 +181,7 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["estimator"] = lightcuts::estimatorName(a.estimator);
   j["visibility_probes"] = switchName(a.visibilityProbes);
   j["probed_clusters"] = es.probedClusters;
+  j["probes_ruled_out"] = es.probesRuledOut;
   j["probe_rays"] = es.probeRays;
   j["occluded_shadow_rays"] = es.occludedRays;
   j["hidden_clusters"] = es.hiddenClusters;

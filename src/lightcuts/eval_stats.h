@@ -20,6 +20,7 @@ struct EvalStats {
   uint64_t reconstructedPoints = 0;  // shading points given a reconstruction cut
   uint64_t reconstructedRays = 0;    // the shadow rays those points sent (in shadowRays too)
   uint64_t probedClusters = 0;       // clusters tested for being hidden as a whole
+  uint64_t probesRuledOut = 0;       // of those, failed before any ray (a corner misses the blocker's box)
   uint64_t probeRays = 0;            // the shadow rays those tests cast (in shadowRays too)
   uint64_t occludedRays = 0;         // shadow rays that found their light hidden
   uint64_t hiddenClusters = 0;       // clusters kept in a cut as hidden by their probes
@@ -81,6 +82,7 @@ struct EvalStats {
     reconstructedPoints += o.reconstructedPoints;
     reconstructedRays += o.reconstructedRays;
     probedClusters += o.probedClusters;
+    probesRuledOut += o.probesRuledOut;
     probeRays += o.probeRays;
     occludedRays += o.occludedRays;
     hiddenClusters += o.hiddenClusters;

@@ -130,6 +130,25 @@ constexpr uint32_t kClearFailuresPerSuccess = 8;
 // (reconstruction.h), so the samples refine them as before (left whole, they put 18% of the
 // dense luminous object's pixels over 2% at 512²).
 
+// Whether the segment p + t dir, t in [0, tMax], meets the box [lo, hi] (slabs; a zero
+// component of dir leaves its slab's test to p's own coordinate).
+inline bool segmentMeetsBox(const Vec3& p, const Vec3& dir, float tMax, const Vec3& lo, const Vec3& hi) {
+  float t0 = 0, t1 = tMax;
+  for (int a = 0; a < 3; ++a) {
+    if (dir[a] == 0) {
+      if (p[a] < lo[a] || p[a] > hi[a]) return false;
+      continue;
+    }
+    const float inv = 1 / dir[a];
+    float ta = (lo[a] - p[a]) * inv, tb = (hi[a] - p[a]) * inv;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
 // What a representative's shadow ray found (recorded for reconstruction cuts) and, when
 // asked for, what stopped it (for the visibility probes).
 struct ShadowResult {
@@ -611,14 +630,32 @@ class Lightcuts final : public LightEvaluator {
     const float dMin = length(vmax(vmax(n.lo - sp.p, sp.p - n.hi), Vec3(0.0f)));
     if (rep.blocker < 0 || !(rep.tHit < dMin)) return false;
     ++stats.probedClusters;
+    Vec3 dirs[8];
+    float dists[8];
+    int m = 0;
     for (int k = 0; k < 8; ++k) {
       // A flat box has only four distinct corners: the others repeat them.
       if (((k & 1) && n.lo.x == n.hi.x) || ((k & 2) && n.lo.y == n.hi.y) || ((k & 4) && n.lo.z == n.hi.z)) continue;
       Vec3 corner((k & 1) ? n.hi.x : n.lo.x, (k & 2) ? n.hi.y : n.lo.y, (k & 4) ? n.hi.z : n.lo.z);
       Vec3 d = corner - sp.p;
-      float dist = length(d);
-      Vec3 wi = d / dist;
-      if (!(dot(wi, sp.n) > 0)) return false;
+      dists[m] = length(d);
+      dirs[m] = d / dists[m];
+      if (!(dot(dirs[m], sp.n) > 0)) return false;
+      ++m;
+    }
+    // A corner whose ray cannot meet the blocker's box before dMin cannot be hidden by it:
+    // the probe would fail there, so it fails now, before any ray (a thin upright in front
+    // of a wide cluster). The same answers as the rays', for fewer rays.
+    Vec3 blo, bhi;
+    if (vis.blockerBox(rep.blocker, blo, bhi))
+      for (int i = 0; i < m; ++i)
+        if (!segmentMeetsBox(sp.p, dirs[i], dMin, blo, bhi)) {
+          ++stats.probesRuledOut;
+          return false;
+        }
+    for (int i = 0; i < m; ++i) {
+      const Vec3& wi = dirs[i];
+      const float dist = dists[i];
       ++stats.shadowRays;
       ++stats.probeRays;
       int blocker;

@@ -428,6 +428,42 @@ TEST(VisibilityProbes, AHiddenCloudStaysOneCluster) {
   EXPECT_EQ(c.cutSize, 2000u);
 }
 
+// The same ball, with its bounds for the probes' test without rays (Visibility::blockerBox).
+struct BoxedBall : Ball {
+  using Ball::Ball;
+  bool blockerBox(int blocker, Vec3& lo, Vec3& hi) const override {
+    if (blocker != 7) return false;
+    lo = centre - Vec3(radius * 1.0001f);
+    hi = centre + Vec3(radius * 1.0001f);
+    return true;
+  }
+};
+
+// A probe whose corner ray cannot meet the blocker's box fails before any ray; the answers
+// are the rays' own, so the cuts are the same, for fewer probe rays.
+TEST(VisibilityProbes, TheBlockersBoxRulesOutProbesWithoutChangingAnswers) {
+  LightSet s = cloud(3000, LightType::Omni, 23);
+  LightForest f = buildLightForest(s);
+  auto lcut = makeLightcuts(s, f, withProbes(true));
+  EvalStats traced, boxed;
+  for (int i = 0; i < 16; ++i) {
+    ShadingPoint sp = point(Vec3(0.25f * float(i) - 2.0f, 0, 0.1f * float(i) - 0.8f));
+    const Vec3 c = sp.p + Vec3(0.2f * float(i % 4) - 0.3f, 1.0f, 0.1f);
+    Ball ball(sp.p, c, 0.35f);
+    BoxedBall boxedBall(sp.p, c, 0.35f);
+    EvalResult a = lcut->evaluate(sp, ball, traced);
+    EvalResult b = lcut->evaluate(sp, boxedBall, boxed);
+    EXPECT_EQ(a.radiance, b.radiance) << i;
+    EXPECT_EQ(a.cutSize, b.cutSize) << i;
+  }
+  EXPECT_EQ(traced.hiddenClusters, boxed.hiddenClusters);
+  EXPECT_GT(boxed.hiddenClusters, 0u);
+  EXPECT_EQ(traced.probesRuledOut, 0u);
+  EXPECT_GT(boxed.probesRuledOut, 0u);
+  EXPECT_LT(boxed.probeRays, traced.probeRays);
+  EXPECT_EQ(traced.shadowRays - traced.probeRays, boxed.shadowRays - boxed.probeRays);
+}
+
 // Partly hidden clouds: with a zero threshold the cut refines everything it cannot prove
 // hidden, so it must equal brute force exactly; proven-hidden clusters must have been
 // truly hidden.

@@ -54,6 +54,11 @@ class Visibility {
   // calls (what stopped an earlier test, tried first); kNoHint to begin with.
   static constexpr uint32_t kNoHint = ~0u;
   virtual bool boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) { return false; }
+  // A box that every shadow ray from this point which trace() finds stopped by convex
+  // object `blocker` passes through within its first `dist` (the object's bounds, padded
+  // for the ray's offset from the point): a ray toward wi that misses it cannot be
+  // stopped by that object there. False when not known (and by default).
+  virtual bool blockerBox(int blocker, Vec3& lo, Vec3& hi) const { return false; }
 };
 
 // M * G of one light per unit intensity, without visibility. Returns false when the

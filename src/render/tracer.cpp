@@ -76,6 +76,21 @@ bool ShadowRays::boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) {
   return scene_.occluders().clear(p_ + ng_ * eps_, lo, hi, 0.1f * eps_, 2 * eps_, ownShape_, &hint);
 }
 
+// A ray leaves from p + ng eps plus a step of eps along it (origin()), so it lies within
+// 2 eps of the segment from p the probe tests; the bounds are padded by that and by their
+// own float rounding.
+bool ShadowRays::blockerBox(int blocker, Vec3& lo, Vec3& hi) const {
+  if (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)) return false;
+  const Bounds3& b = scene_.convexBounds(blocker);
+  if (b.empty()) return false;
+  const Vec3 big = vmax(vabs(b.lo), vabs(b.hi));
+  const float pad = 4 * eps_ + 1e-5f * std::max({big.x, big.y, big.z, length(p_)});
+  if (!std::isfinite(pad)) return false;
+  lo = b.lo - Vec3(pad);
+  hi = b.hi + Vec3(pad);
+  return true;
+}
+
 // The ray: from p' = p + ng eps, off the surface on the light's side, toward the light
 // itself (p + wi dist); it starts a step of eps along the way and ends 2 eps short of the
 // light. The step matters on an edge where two surfaces meet (a room's corner): the point

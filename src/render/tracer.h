@@ -33,6 +33,7 @@ class ShadowRays final : public lightcuts::Visibility {
   Color operator()(const Vec3& wi, float dist) override;
   Color trace(const Vec3& wi, float dist, int& blocker, float& tHit) override;
   bool boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) override;
+  bool blockerBox(int blocker, Vec3& lo, Vec3& hi) const override;
 
  private:
   Vec3 origin(const Vec3& wi, float dist, float& tmax, Vec3& dir) const;

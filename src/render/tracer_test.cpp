@@ -80,5 +80,46 @@ TEST(ShadowRays, FarLightsAreTracedAlongTheirDirection) {
   EXPECT_EQ(vis(normalize(Vec3(0.02f, 1, 0)), far).x, 1);
 }
 
+// The box a probe asks for (Visibility::blockerBox): every ray that trace() finds stopped
+// by a convex shape passes through it before the hit; none for a shape that is not convex.
+TEST(ShadowRays, ABlockersBoxHoldsEveryHitOnIt) {
+  auto scene = scene::Scene::build(io::parseRayString(R"(SBT-raytracer 1.0
+material = { name = white; diffuse = (0.5, 0.5, 0.5); }
+translate(0, 0, -0.05, scale(20, 20, 0.1, box { material = white; }))
+translate(0.3, -0.2, 2, rotate(1, 1, 0, 0.6, scale(1.5, 0.2, 0.4, box { material = white; })))
+translate(-1, 1, 3, sphere { material = white; })
+trimesh { material = white; points = ((-5, -5, 6), (5, -5, 6), (0, 5, 6)); faces = ((0, 1, 2)); }
+)",
+                                                      "blockers.ray", ""));
+  scene::Hit h;
+  ASSERT_TRUE(scene->intersect(scene::Ray{Vec3(0, 0, 1), Vec3(0, 0, -1)}, h));
+  ShadowRays vis(*scene, h);
+  int hits[4] = {};
+  for (int i = 0; i < 400; ++i) {
+    const Vec3 target(float(i % 20) * 0.5f - 5.0f, float(i / 20) * 0.5f - 5.0f, 7.0f);
+    const Vec3 d = target - h.p;
+    const float dist = length(d);
+    int blocker;
+    float tHit;
+    vis.trace(d / dist, dist, blocker, tHit);
+    if (blocker < 0) continue;
+    ASSERT_LT(blocker, 4);
+    ++hits[blocker];
+    Vec3 lo, hi;
+    ASSERT_TRUE(vis.blockerBox(blocker, lo, hi)) << blocker;
+    const Vec3 q = h.p + d / dist * tHit;
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_GE(q[a], lo[a]) << blocker;
+      EXPECT_LE(q[a], hi[a]) << blocker;
+    }
+  }
+  EXPECT_GT(hits[1], 0);  // the turned box
+  EXPECT_GT(hits[2], 0);  // the sphere
+  Vec3 lo, hi;
+  EXPECT_FALSE(vis.blockerBox(lightcuts::Visibility::kUnknownBlocker, lo, hi));
+  EXPECT_FALSE(vis.blockerBox(lightcuts::Visibility::kVisible, lo, hi));
+  EXPECT_FALSE(vis.blockerBox(99, lo, hi));
+}
+
 }  // namespace
 }  // namespace lc::render

@@ -297,11 +297,20 @@ void Scene::buildGeometry(const BuildOptions& options) {
   // quads seen head-on and would let shadow rays through closed meshes.
   rtcSetSceneFlags(rtc_, RTC_SCENE_FLAG_ROBUST);
   convex_.resize(shapes_.size());
+  convexBounds_.assign(shapes_.size(), Bounds3());
   transmissive_.resize(shapes_.size());
   for (size_t i = 0; i < shapes_.size(); ++i) {
     Shape& sh = shapes_[i];
     const Mesh* mesh = sh.kind == ShapeKind::Mesh ? &meshes_[size_t(sh.mesh)] : nullptr;
     convex_[i] = isConvexShape(sh, mesh);
+    if (convex_[i]) {
+      if (mesh) {
+        for (const auto& t : mesh->triangles)
+          for (int k : t) convexBounds_[i].extend(mesh->positions[size_t(k)]);
+      } else {
+        convexBounds_[i] = quadricBounds(sh);
+      }
+    }
     bool glass = !materials_[size_t(sh.material)].transmissive.isBlack();
     if (mesh) {
       for (int m : mesh->triangleMaterials) glass |= !materials_[size_t(m)].transmissive.isBlack();

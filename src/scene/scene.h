@@ -79,6 +79,9 @@ class Scene {
   // Whether a shape is a convex solid or a flat convex polygon: one that blocks a set of
   // directions from a point blocks their convex hull too.
   bool isConvex(int shape) const { return convex_[size_t(shape)] != 0; }
+  // World bounds of a convex shape (isConvex; empty for the others): a ray that meets the
+  // shape meets its box.
+  const Bounds3& convexBounds(int shape) const { return convexBounds_[size_t(shape)]; }
   // Whether light can pass through some part of a shape (a transmissive material).
   bool isTransmissive(int shape) const { return shadowsThroughGlass_ && transmissive_[size_t(shape)] != 0; }
   // Every surface as convex pieces, for proving a set of segments clear (occluders.h).
@@ -132,6 +135,7 @@ class Scene {
   bool hasTransmissive_ = false;
   bool shadowsThroughGlass_ = true;
   std::vector<uint8_t> convex_;        // per shape
+  std::vector<Bounds3> convexBounds_;  // per shape: its world bounds if convex, else empty
   std::vector<uint8_t> transmissive_;  // per shape
   OccluderIndex occluders_;
   RTCDevice device_ = nullptr;
