@@ -653,6 +653,12 @@ class Lightcuts final : public LightEvaluator {
           ++stats.probesRuledOut;
           return false;
         }
+    // A box or a sphere is asked directly whether it stops every corner's segment: no rays.
+    switch (vis.blocksAll(rep.blocker, dirs, m, dMin)) {
+      case 0: ++stats.probesRuledOut; return false;
+      case 1: return true;
+      default: break;
+    }
     for (int i = 0; i < m; ++i) {
       const Vec3& wi = dirs[i];
       const float dist = dists[i];

@@ -464,6 +464,45 @@ TEST(VisibilityProbes, TheBlockersBoxRulesOutProbesWithoutChangingAnswers) {
   EXPECT_EQ(traced.shadowRays - traced.probeRays, boxed.shadowRays - boxed.probeRays);
 }
 
+// The same ball, deciding probes itself (Visibility::blocksAll): a segment through the
+// ball shrunk by a margin is stopped by it.
+struct ExactBall : Ball {
+  using Ball::Ball;
+  int blocksAll(int blocker, const Vec3* dirs, int n, float tMax) const override {
+    if (blocker != 7) return -1;
+    const float r = radius - 1e-3f;
+    for (int i = 0; i < n; ++i) {
+      const Vec3 oc = from - centre;
+      const float b = dot(oc, dirs[i]), c = dot(oc, oc) - r * r, disc = b * b - c;
+      if (!(disc > 0) || !(-b - std::sqrt(disc) < tMax)) return 0;
+    }
+    return 1;
+  }
+};
+
+// Probes decided without rays are as exact as the rays': with a zero threshold every
+// cluster not proven hidden is refined to its lights, so the cut must equal brute force.
+TEST(VisibilityProbes, ProbesDecidedWithoutRaysAreExact) {
+  LightSet s = cloud(3000, LightType::Omni, 24);
+  LightForest f = buildLightForest(s);
+  auto bf = makeBruteForce(s);
+  auto lcut = makeLightcuts(s, f, withProbes(true, 0.0f));
+  EvalStats st, sb, traced;
+  for (int i = 0; i < 12; ++i) {
+    ShadingPoint sp = point(Vec3(0.3f * float(i) - 1.8f, 0, 0.1f * float(i) - 0.5f));
+    const Vec3 c = sp.p + Vec3(0.2f * float(i % 4) - 0.3f, 1.0f, 0.1f);
+    ExactBall ball(sp.p, c, 0.35f);
+    Ball plain(sp.p, c, 0.35f);
+    Color want = bf->evaluate(sp, ball, sb).radiance;
+    Color got = lcut->evaluate(sp, ball, st).radiance;
+    (void)lcut->evaluate(sp, plain, traced);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], 1e-5f * (want[k] + 1e-6f)) << i;
+  }
+  EXPECT_GT(st.hiddenClusters, 0u);
+  EXPECT_EQ(st.probeRays, 0u);
+  EXPECT_GT(traced.probeRays, 0u);
+}
+
 // Partly hidden clouds: with a zero threshold the cut refines everything it cannot prove
 // hidden, so it must equal brute force exactly; proven-hidden clusters must have been
 // truly hidden.

@@ -59,6 +59,11 @@ class Visibility {
   // for the ray's offset from the point): a ray toward wi that misses it cannot be
   // stopped by that object there. False when not known (and by default).
   virtual bool blockerBox(int blocker, Vec3& lo, Vec3& hi) const { return false; }
+  // Whether convex object `blocker` certainly stops every shadow ray from this point toward
+  // the unit directions dirs[0, n) nearer than tMax, decided without rays (each segment
+  // passes through its inside, deeper than the rays' offsets from it): 1 yes, 0 not proven,
+  // -1 cannot tell (the caller traces rays). -1 by default.
+  virtual int blocksAll(int blocker, const Vec3* dirs, int n, float tMax) const { return -1; }
 };
 
 // M * G of one light per unit intensity, without visibility. Returns false when the

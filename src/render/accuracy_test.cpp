@@ -445,9 +445,10 @@ TEST(Accuracy, SubSamplesBeyondTheirSamplesNearASurfaceTakeFullCuts) {
 TEST(Accuracy, SubSamplesFullCutsServeTheRestOfTheirPixel) {
   const auto [own, shared] = fenceOffOn(&RenderOptions::aaPixelSamples);
   // Measured: full cuts 232,219 -> 107,833, shadow rays -25%, reference pixels over 2%
-  // 0.39% -> 0.46%, the worst pixel 3.8% -> 8.6%.
+  // 0.39% -> 0.46%, the worst pixel 3.8% -> 8.6%. Since probes against boxes are decided
+  // without rays the full cuts it saves are cheaper: shadow rays 34.7M -> 28.3M (-19%).
   EXPECT_LT(shared.stats.reconstructionFallbacks * 2, own.stats.reconstructionFallbacks);
-  EXPECT_LT(shared.stats.eval.shadowRays * 10, own.stats.eval.shadowRays * 8);
+  EXPECT_LT(shared.stats.eval.shadowRays * 100, own.stats.eval.shadowRays * 88);
   EXPECT_LT(shared.stats.reference.fractionOver2pct, 0.01);
   EXPECT_LT(shared.stats.reference.fractionOver2pct, own.stats.reference.fractionOver2pct + 0.002);
   EXPECT_LT(shared.stats.reference.maxRelativeError, 0.1);

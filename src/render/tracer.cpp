@@ -91,6 +91,24 @@ bool ShadowRays::blockerBox(int blocker, Vec3& lo, Vec3& hi) const {
   return true;
 }
 
+// A shadow ray leaves from within 2 eps of p (origin()) and so runs within 2 eps of the
+// segment from p to its light, ending 3 eps short of it. The corners' segments stand for
+// those (the directions that meet a convex body's inside, shrunk by a margin, within a
+// distance form a convex cone): one that passes through the blocker 4 eps deep (plus the
+// coordinates' rounding), from that margin past p to that margin before tMax, stops the
+// rays too. Boxes and spheres are decided exactly (scene::segmentSurelyMeets); other
+// shapes are left to the rays.
+int ShadowRays::blocksAll(int blocker, const Vec3* dirs, int n, float tMax) const {
+  if (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)) return -1;
+  const scene::Shape& s = scene_.shapes()[size_t(blocker)];
+  if (!scene::canProveMeets(s)) return -1;
+  const float margin = 4 * eps_ + 1e-5f * (length(p_) + tMax);
+  if (!std::isfinite(margin)) return -1;
+  for (int i = 0; i < n; ++i)
+    if (!scene::segmentSurelyMeets(s, p_, dirs[i], margin, tMax - margin, margin)) return 0;
+  return 1;
+}
+
 // The ray: from p' = p + ng eps, off the surface on the light's side, toward the light
 // itself (p + wi dist); it starts a step of eps along the way and ends 2 eps short of the
 // light. The step matters on an edge where two surfaces meet (a room's corner): the point

@@ -34,6 +34,7 @@ class ShadowRays final : public lightcuts::Visibility {
   Color trace(const Vec3& wi, float dist, int& blocker, float& tHit) override;
   bool boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) override;
   bool blockerBox(int blocker, Vec3& lo, Vec3& hi) const override;
+  int blocksAll(int blocker, const Vec3* dirs, int n, float tMax) const override;
 
  private:
   Vec3 origin(const Vec3& wi, float dist, float& tmax, Vec3& dir) const;

@@ -253,6 +253,51 @@ Bounds3 quadricBounds(const Shape& s) {
   return world;
 }
 
+bool segmentSurelyMeets(const Shape& s, const Vec3& of, const Vec3& df, float tLo, float tHi, float margin) {
+  if (!canProveMeets(s) || !(tLo <= tHi) || !(margin >= 0)) return false;
+  const auto& L = s.toLocal.m;
+  // A world displacement of length m moves local coordinate i by at most m times the norm
+  // of row i of toLocal, and the local point by at most m times the Frobenius norm.
+  double o[3], d[3], row[3], f2 = 0;
+  for (int i = 0; i < 3; ++i) {
+    const auto& r = L[size_t(i)];
+    o[i] = r[0] * of.x + r[1] * of.y + r[2] * of.z + r[3];
+    d[i] = r[0] * df.x + r[1] * df.y + r[2] * df.z;
+    const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    row[i] = std::sqrt(r2);
+    f2 += r2;
+  }
+  double t0 = tLo, t1 = tHi;
+  if (s.kind == io::ShapeKind::Box) {
+    for (int i = 0; i < 3; ++i) {
+      const double h = 0.5 - double(margin) * row[i] - 1e-6;  // the slab shrunk by the depth
+      if (!(h > 0)) return false;
+      if (d[i] == 0) {
+        if (o[i] <= -h || o[i] >= h) return false;
+        continue;
+      }
+      double ta = (-h - o[i]) / d[i], tb = (h - o[i]) / d[i];
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+    }
+    return t0 < t1;
+  }
+  // The unit sphere shrunk to radius 1 - depth: |o + t d|^2 < r^2 on an open interval.
+  const double r = 1 - double(margin) * std::sqrt(f2) - 1e-6;
+  if (!(r > 0)) return false;
+  const double a = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+  if (!(a > 0)) return false;
+  const double b = o[0] * d[0] + o[1] * d[1] + o[2] * d[2];
+  const double c = o[0] * o[0] + o[1] * o[1] + o[2] * o[2] - r * r;
+  const double disc = b * b - a * c;
+  if (!(disc > 0)) return false;
+  const double q = std::sqrt(disc);
+  t0 = std::max(t0, (-b - q) / a);
+  t1 = std::min(t1, (-b + q) / a);
+  return t0 < t1;
+}
+
 bool isConvexShape(const Shape& s, const Mesh* mesh) {
   switch (s.kind) {
     case io::ShapeKind::Sphere:

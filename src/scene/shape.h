@@ -58,6 +58,16 @@ Bounds3 quadricLocalBounds(const Shape& s);
 // World bounds of a quadric (its local bounding box, transformed).
 Bounds3 quadricBounds(const Shape& s);
 
+// Whether the segment o + t d (world space), t in [tLo, tHi], certainly passes through the
+// inside of shape s at depth `margin` (world units) or more: some point of it has the whole
+// ball of that radius inside the shape. Exact for boxes and spheres under any affine
+// transform (in double, the depth taken in local units through a bound on toLocal's
+// stretch); false for every other kind, which the caller tells by canProveMeets.
+bool segmentSurelyMeets(const Shape& s, const Vec3& o, const Vec3& d, float tLo, float tHi, float margin);
+inline bool canProveMeets(const Shape& s) {
+  return s.kind == io::ShapeKind::Box || s.kind == io::ShapeKind::Sphere;
+}
+
 // Whether the shape is a convex solid (sphere, box, capped cylinder or cone, a closed
 // mesh with every vertex behind every face's plane) or a flat convex polygon (square, a
 // planar mesh whose triangles cover exactly the convex hull of its vertices). Any affine

@@ -1,5 +1,8 @@
-// isConvexShape: which shapes the visibility probes may treat as convex occluders.
+// isConvexShape: which shapes the visibility probes may treat as convex occluders; and
+// segmentSurelyMeets, which lets a probe prove a box or sphere in the way without rays.
 #include <gtest/gtest.h>
+
+#include <random>
 
 #include "scene/shape.h"
 
@@ -82,6 +85,86 @@ TEST(ConvexShape, FlatMeshesAreConvexWhenTheyFillTheirHull) {
   ell.positions = {{0, 0, 0}, {2, 0, 0}, {2, 0, 1}, {1, 0, 1}, {1, 0, 2}, {0, 0, 2}, {1, 0, 0}, {0, 0, 1}};
   ell.triangles = {{0, 6, 3}, {0, 3, 7}, {6, 1, 2}, {6, 2, 3}, {7, 3, 4}, {7, 4, 5}};
   EXPECT_FALSE(isConvexShape(s, &ell));
+}
+
+}  // namespace
+}  // namespace lc::scene
+
+namespace lc::scene {
+namespace {
+
+// A box or sphere turned, stretched and moved: toWorld = T R S, toLocal its inverse.
+Shape placed(io::ShapeKind kind) {
+  Shape s;
+  s.kind = kind;
+  const Vec3 axis = normalize(Vec3(1, 2, 0.5f));
+  s.toWorld = Mat4::translate(1, 2, 3) * Mat4::rotate(axis.x, axis.y, axis.z, 0.7) * Mat4::scale(2, 0.3, 1);
+  s.toLocal = Mat4::scale(0.5, 1 / 0.3, 1) * Mat4::rotate(axis.x, axis.y, axis.z, -0.7) * Mat4::translate(-1, -2, -3);
+  return s;
+}
+
+// Whether the world segment o + t d, t in [t0, t1], meets the shape (its own hit test).
+bool hits(const Shape& s, const Vec3& o, const Vec3& d, float t0, float t1) {
+  float t;
+  int part;
+  const Vec3 lo = s.toLocal.point(o), ld = s.toLocal.vector(d);
+  // Inside at t0 counts too (the hit test finds only the surface ahead).
+  const Vec3 start = lo + ld * t0;
+  const bool inside = s.kind == io::ShapeKind::Box
+                          ? std::fabs(start.x) < 0.5f && std::fabs(start.y) < 0.5f && std::fabs(start.z) < 0.5f
+                          : length2(start) < 1;
+  return inside || intersectQuadric(s, lo, ld, t0, t1, t, part);
+}
+
+// segmentSurelyMeets claims a segment only when every segment within `margin` of it meets
+// the shape too (the shadow rays a probe stands for leave from near the point), and never
+// when it misses or only grazes the shape.
+TEST(ShapeMeets, SegmentsClaimedPassDeepThroughBoxesAndSpheres) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1, 1);
+  const float margin = 0.04f;
+  for (io::ShapeKind kind : {io::ShapeKind::Box, io::ShapeKind::Sphere}) {
+    const Shape s = placed(kind);
+    int claimed = 0, missed = 0;
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3 o = Vec3(1, 2, 3) + Vec3(u(rng), u(rng), u(rng)) * 6.0f;
+      const Vec3 aim = Vec3(1, 2, 3) + Vec3(u(rng), u(rng), u(rng)) * 1.5f;
+      const float len = length(aim - o);
+      const Vec3 d = (aim - o) / len;
+      const float t1 = len * 1.5f;
+      if (!segmentSurelyMeets(s, o, d, 0, t1, margin)) {
+        missed += !hits(s, o, d, 0, t1);
+        continue;
+      }
+      ++claimed;
+      ASSERT_TRUE(hits(s, o, d, 0, t1)) << i;
+      for (int k = 0; k < 12; ++k) {
+        // Another segment whose ends lie within the margin of this one's, and nearly the same length.
+        const Vec3 shiftO = normalize(Vec3(u(rng), u(rng), u(rng))) * (0.9f * margin * std::fabs(u(rng)));
+        const Vec3 shiftE = normalize(Vec3(u(rng), u(rng), u(rng))) * (0.9f * margin * std::fabs(u(rng)));
+        const Vec3 o2 = o + shiftO, e2 = o + d * t1 + shiftE;
+        const float len2 = length(e2 - o2);
+        ASSERT_TRUE(hits(s, o2, (e2 - o2) / len2, 0, len2)) << i << " " << k;
+      }
+    }
+    EXPECT_GT(claimed, 200) << int(kind);
+    EXPECT_GT(missed, 200) << int(kind);
+  }
+  // The unit box, as given: a segment through its middle is claimed, one that passes
+  // within the margin of a face is not, nor one that ends before the box or starts after it.
+  Shape box;
+  box.kind = io::ShapeKind::Box;
+  EXPECT_TRUE(segmentSurelyMeets(box, Vec3(-2, 0, 0), Vec3(1, 0, 0), 0, 4, 0.01f));
+  EXPECT_FALSE(segmentSurelyMeets(box, Vec3(-2, 0.495f, 0), Vec3(1, 0, 0), 0, 4, 0.01f));
+  EXPECT_FALSE(segmentSurelyMeets(box, Vec3(-2, 0, 0), Vec3(1, 0, 0), 0, 1.4f, 0.2f));
+  EXPECT_FALSE(segmentSurelyMeets(box, Vec3(-2, 0, 0), Vec3(1, 0, 0), 2.6f, 4, 0.2f));
+  // Shapes it does not decide.
+  for (io::ShapeKind kind : {io::ShapeKind::Square, io::ShapeKind::Cylinder, io::ShapeKind::Cone, io::ShapeKind::Mesh}) {
+    Shape other;
+    other.kind = kind;
+    EXPECT_FALSE(canProveMeets(other));
+    EXPECT_FALSE(segmentSurelyMeets(other, Vec3(-2, 0, 0.5f), Vec3(1, 0, 0), 0, 4, 0.01f));
+  }
 }
 
 }  // namespace
