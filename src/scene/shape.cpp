@@ -283,6 +283,31 @@ bool segmentSurelyMeets(const Shape& s, const Vec3& of, const Vec3& df, float tL
     }
     return t0 < t1;
   }
+  if (s.kind == io::ShapeKind::Cylinder) {
+    // The solid x^2 + y^2 <= 1, 0 <= z <= 1, shrunk: its radius by the depth in x and y
+    // together, its height by the depth in z at each cap.
+    const double r = 1 - double(margin) * std::sqrt(row[0] * row[0] + row[1] * row[1]) - 1e-6;
+    const double zLo = double(margin) * row[2] + 1e-6, zHi = 1 - zLo;
+    if (!(r > 0) || !(zLo < zHi)) return false;
+    if (d[2] == 0) {
+      if (o[2] <= zLo || o[2] >= zHi) return false;
+    } else {
+      double ta = (zLo - o[2]) / d[2], tb = (zHi - o[2]) / d[2];
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+    }
+    const double a = d[0] * d[0] + d[1] * d[1];
+    const double b = o[0] * d[0] + o[1] * d[1];
+    const double c = o[0] * o[0] + o[1] * o[1] - r * r;
+    if (a == 0) return c < 0 && t0 < t1;  // along the axis: inside the radius throughout
+    const double disc = b * b - a * c;
+    if (!(disc > 0)) return false;
+    const double q = std::sqrt(disc);
+    t0 = std::max(t0, (-b - q) / a);
+    t1 = std::min(t1, (-b + q) / a);
+    return t0 < t1;
+  }
   // The unit sphere shrunk to radius 1 - depth: |o + t d|^2 < r^2 on an open interval.
   const double r = 1 - double(margin) * std::sqrt(f2) - 1e-6;
   if (!(r > 0)) return false;

@@ -60,12 +60,13 @@ Bounds3 quadricBounds(const Shape& s);
 
 // Whether the segment o + t d (world space), t in [tLo, tHi], certainly passes through the
 // inside of shape s at depth `margin` (world units) or more: some point of it has the whole
-// ball of that radius inside the shape. Exact for boxes and spheres under any affine
-// transform (in double, the depth taken in local units through a bound on toLocal's
-// stretch); false for every other kind, which the caller tells by canProveMeets.
+// ball of that radius inside the shape. Exact for boxes, spheres and capped cylinders under
+// any affine transform (in double, the depth taken in local units through a bound on
+// toLocal's stretch); false for every other kind, which the caller tells by canProveMeets.
 bool segmentSurelyMeets(const Shape& s, const Vec3& o, const Vec3& d, float tLo, float tHi, float margin);
 inline bool canProveMeets(const Shape& s) {
-  return s.kind == io::ShapeKind::Box || s.kind == io::ShapeKind::Sphere;
+  return s.kind == io::ShapeKind::Box || s.kind == io::ShapeKind::Sphere ||
+         (s.kind == io::ShapeKind::Cylinder && s.capped);
 }
 
 // Whether the shape is a convex solid (sphere, box, capped cylinder or cone, a closed

@@ -110,9 +110,10 @@ bool hits(const Shape& s, const Vec3& o, const Vec3& d, float t0, float t1) {
   const Vec3 lo = s.toLocal.point(o), ld = s.toLocal.vector(d);
   // Inside at t0 counts too (the hit test finds only the surface ahead).
   const Vec3 start = lo + ld * t0;
-  const bool inside = s.kind == io::ShapeKind::Box
-                          ? std::fabs(start.x) < 0.5f && std::fabs(start.y) < 0.5f && std::fabs(start.z) < 0.5f
-                          : length2(start) < 1;
+  const bool inside =
+      s.kind == io::ShapeKind::Box        ? std::fabs(start.x) < 0.5f && std::fabs(start.y) < 0.5f && std::fabs(start.z) < 0.5f
+      : s.kind == io::ShapeKind::Cylinder ? start.x * start.x + start.y * start.y < 1 && start.z > 0 && start.z < 1
+                                          : length2(start) < 1;
   return inside || intersectQuadric(s, lo, ld, t0, t1, t, part);
 }
 
@@ -123,7 +124,7 @@ TEST(ShapeMeets, SegmentsClaimedPassDeepThroughBoxesAndSpheres) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-1, 1);
   const float margin = 0.04f;
-  for (io::ShapeKind kind : {io::ShapeKind::Box, io::ShapeKind::Sphere}) {
+  for (io::ShapeKind kind : {io::ShapeKind::Box, io::ShapeKind::Sphere, io::ShapeKind::Cylinder}) {
     const Shape s = placed(kind);
     int claimed = 0, missed = 0;
     for (int i = 0; i < 2000; ++i) {
@@ -158,10 +159,11 @@ TEST(ShapeMeets, SegmentsClaimedPassDeepThroughBoxesAndSpheres) {
   EXPECT_FALSE(segmentSurelyMeets(box, Vec3(-2, 0.495f, 0), Vec3(1, 0, 0), 0, 4, 0.01f));
   EXPECT_FALSE(segmentSurelyMeets(box, Vec3(-2, 0, 0), Vec3(1, 0, 0), 0, 1.4f, 0.2f));
   EXPECT_FALSE(segmentSurelyMeets(box, Vec3(-2, 0, 0), Vec3(1, 0, 0), 2.6f, 4, 0.2f));
-  // Shapes it does not decide.
+  // Shapes it does not decide: flat ones, open tubes, cones, meshes.
   for (io::ShapeKind kind : {io::ShapeKind::Square, io::ShapeKind::Cylinder, io::ShapeKind::Cone, io::ShapeKind::Mesh}) {
     Shape other;
     other.kind = kind;
+    other.capped = kind != io::ShapeKind::Cylinder;
     EXPECT_FALSE(canProveMeets(other));
     EXPECT_FALSE(segmentSurelyMeets(other, Vec3(-2, 0, 0.5f), Vec3(1, 0, 0), 0, 4, 0.01f));
   }
