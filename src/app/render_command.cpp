@@ -658,8 +658,9 @@ void addRenderCommand(CLI::App& app) {
       ->group(cuts);
   addSwitch(*c, "--visibility-probes", a->visibilityProbes,
             fmt::format("Lightcuts: before refining a cluster whose representative is hidden, test the corners of "
-                        "its box; when one convex object hides them all, the cluster stays in the cut as hidden "
-                        "(on) or not (off, as published); default {}", switchName(d.visibilityProbes)))
+                        "its box (boxes, spheres and capped cylinders answer without rays); when one convex object "
+                        "hides them all, the cluster stays in the cut as hidden (on) or not (off, as published); "
+                        "default {}", switchName(d.visibilityProbes)))
       ->group(cuts);
   addSwitch(*c, "--clear-clusters", a->clearClusters,
             fmt::format("Lightcuts: test a cluster whose representative is visible for being visible as a whole, "

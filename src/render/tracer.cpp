@@ -104,6 +104,9 @@ int ShadowRays::blocksAll(int blocker, const Vec3* dirs, int n, float tMax) cons
   if (!scene::canProveMeets(s)) return -1;
   const float margin = 4 * eps_ + 1e-5f * (length(p_) + tMax);
   if (!std::isfinite(margin)) return -1;
+  // From inside the shape (a room modelled as one box, seen from within) a segment runs
+  // through it without crossing its surface: the rays decide, as before.
+  if (!scene::pointSurelyOutside(s, p_, margin)) return -1;
   for (int i = 0; i < n; ++i)
     if (!scene::segmentSurelyMeets(s, p_, dirs[i], margin, tMax - margin, margin)) return 0;
   return 1;

@@ -121,5 +121,40 @@ trimesh { material = white; points = ((-5, -5, 6), (5, -5, 6), (0, 5, 6)); faces
   EXPECT_FALSE(vis.blockerBox(99, lo, hi));
 }
 
+// A room modelled as one solid box, seen from within: a probe toward lights inside it, past
+// a lamp outside it that the box hides, is left to the rays (a segment from inside a solid
+// crosses no surface); toward a cluster behind a box standing in the room it is decided.
+TEST(ShadowRays, ProbesFromInsideASolidAreLeftToTheRays) {
+  auto scene = scene::Scene::build(io::parseRayString(R"(SBT-raytracer 1.0
+material = { name = white; diffuse = (0.5, 0.5, 0.5); }
+scale(10, 4, 10, translate(0, 0.5, 0, box { material = white; }))
+translate(0, 1, -3, scale(2, 2, 0.2, box { material = white; }))
+)",
+                                                      "room.ray", ""));
+  scene::Hit h;
+  ASSERT_TRUE(scene->intersect(scene::Ray{Vec3(0, 2, 2), Vec3(0, -1, 0)}, h));
+  ASSERT_NEAR(h.p.y, 0, 1e-5);
+  ShadowRays vis(*scene, h);
+  auto dirsTo = [&](const Vec3& lo, const Vec3& hi, Vec3* dirs, float& dMin) {
+    dMin = kInf;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 c((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z);
+      dirs[k] = normalize(c - h.p);
+      dMin = std::min(dMin, length(c - h.p));
+    }
+  };
+  Vec3 dirs[8];
+  float dMin;
+  // Lights in the room, above the point: the room's box must not claim them.
+  dirsTo(Vec3(-0.3f, 2.5f, 1.7f), Vec3(0.3f, 3.0f, 2.3f), dirs, dMin);
+  EXPECT_EQ(vis.blocksAll(0, dirs, 8, dMin), -1);
+  // A cluster behind the standing box (shape 1), seen from the floor in front of it.
+  dirsTo(Vec3(-0.2f, 0.8f, -4.0f), Vec3(0.2f, 1.2f, -3.8f), dirs, dMin);
+  EXPECT_EQ(vis.blocksAll(1, dirs, 8, dMin), 1);
+  // One whose corners pass above it: not proven.
+  dirsTo(Vec3(-0.2f, 2.8f, -4.0f), Vec3(0.2f, 3.2f, -3.8f), dirs, dMin);
+  EXPECT_EQ(vis.blocksAll(1, dirs, 8, dMin), 0);
+}
+
 }  // namespace
 }  // namespace lc::render

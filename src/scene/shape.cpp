@@ -253,6 +253,35 @@ Bounds3 quadricBounds(const Shape& s) {
   return world;
 }
 
+bool pointSurelyOutside(const Shape& s, const Vec3& pf, float margin) {
+  if (!canProveMeets(s) || !(margin >= 0)) return false;
+  const auto& L = s.toLocal.m;
+  double x[3], row[3], f2 = 0;
+  for (int i = 0; i < 3; ++i) {
+    const auto& r = L[size_t(i)];
+    x[i] = r[0] * pf.x + r[1] * pf.y + r[2] * pf.z + r[3];
+    const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+    row[i] = std::sqrt(r2);
+    f2 += r2;
+  }
+  const double m = double(margin);
+  switch (s.kind) {
+    case io::ShapeKind::Box:
+      for (int i = 0; i < 3; ++i)
+        if (std::fabs(x[i]) > 0.5 + m * row[i] + 1e-6) return true;
+      return false;
+    case io::ShapeKind::Cylinder: {
+      const double grow = m * std::sqrt(row[0] * row[0] + row[1] * row[1]) + 1e-6;
+      const double zGrow = m * row[2] + 1e-6;
+      return x[0] * x[0] + x[1] * x[1] > (1 + grow) * (1 + grow) || x[2] < -zGrow || x[2] > 1 + zGrow;
+    }
+    default: {
+      const double R = 1 + m * std::sqrt(f2) + 1e-6;
+      return x[0] * x[0] + x[1] * x[1] + x[2] * x[2] > R * R;
+    }
+  }
+}
+
 bool segmentSurelyMeets(const Shape& s, const Vec3& of, const Vec3& df, float tLo, float tHi, float margin) {
   if (!canProveMeets(s) || !(tLo <= tHi) || !(margin >= 0)) return false;
   const auto& L = s.toLocal.m;

@@ -64,6 +64,10 @@ Bounds3 quadricBounds(const Shape& s);
 // any affine transform (in double, the depth taken in local units through a bound on
 // toLocal's stretch); false for every other kind, which the caller tells by canProveMeets.
 bool segmentSurelyMeets(const Shape& s, const Vec3& o, const Vec3& d, float tLo, float tHi, float margin);
+// Whether p lies outside shape s grown by `margin` (world units), for the kinds
+// segmentSurelyMeets decides (false for the others). A segment from a point inside a solid
+// runs through it without crossing its surface, which is what stops a ray.
+bool pointSurelyOutside(const Shape& s, const Vec3& p, float margin);
 inline bool canProveMeets(const Shape& s) {
   return s.kind == io::ShapeKind::Box || s.kind == io::ShapeKind::Sphere ||
          (s.kind == io::ShapeKind::Cylinder && s.capped);

@@ -120,7 +120,7 @@ bool hits(const Shape& s, const Vec3& o, const Vec3& d, float t0, float t1) {
 // segmentSurelyMeets claims a segment only when every segment within `margin` of it meets
 // the shape too (the shadow rays a probe stands for leave from near the point), and never
 // when it misses or only grazes the shape.
-TEST(ShapeMeets, SegmentsClaimedPassDeepThroughBoxesAndSpheres) {
+TEST(ShapeMeets, SegmentsClaimedPassDeepThroughBoxesSpheresAndCylinders) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-1, 1);
   const float margin = 0.04f;
@@ -150,6 +150,16 @@ TEST(ShapeMeets, SegmentsClaimedPassDeepThroughBoxesAndSpheres) {
     }
     EXPECT_GT(claimed, 200) << int(kind);
     EXPECT_GT(missed, 200) << int(kind);
+  }
+  // A point inside a shape, or on its surface, is not surely outside it; one beyond the
+  // margin is.
+  for (io::ShapeKind kind : {io::ShapeKind::Box, io::ShapeKind::Sphere, io::ShapeKind::Cylinder}) {
+    const Shape s = placed(kind);
+    const Vec3 centre = s.toWorld.point(kind == io::ShapeKind::Cylinder ? Vec3(0, 0, 0.5f) : Vec3(0));
+    const Vec3 surface = s.toWorld.point(kind == io::ShapeKind::Cylinder ? Vec3(1, 0, 0.5f) : Vec3(0.5f, 0, 0));
+    EXPECT_FALSE(pointSurelyOutside(s, centre, margin)) << int(kind);
+    EXPECT_FALSE(pointSurelyOutside(s, surface, margin)) << int(kind);
+    EXPECT_TRUE(pointSurelyOutside(s, centre + Vec3(20, 0, 0), margin)) << int(kind);
   }
   // The unit box, as given: a segment through its middle is claimed, one that passes
   // within the margin of a face is not, nor one that ends before the box or starts after it.
