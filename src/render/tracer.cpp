@@ -96,8 +96,8 @@ bool ShadowRays::blockerBox(int blocker, Vec3& lo, Vec3& hi) const {
 // those (the directions that meet a convex body's inside, shrunk by a margin, within a
 // distance form a convex cone): one that passes through the blocker 4 eps deep (plus the
 // coordinates' rounding), from that margin past p to that margin before tMax, stops the
-// rays too. Boxes and spheres are decided exactly (scene::segmentSurelyMeets); other
-// shapes are left to the rays.
+// rays too. Boxes, spheres and capped cylinders are decided exactly
+// (scene::segmentSurelyMeets); other shapes are left to the rays.
 int ShadowRays::blocksAll(int blocker, const Vec3* dirs, int n, float tMax) const {
   if (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)) return -1;
   const scene::Shape& s = scene_.shapes()[size_t(blocker)];
