@@ -253,6 +253,20 @@ Bounds3 quadricBounds(const Shape& s) {
   return world;
 }
 
+namespace {
+
+// Narrows [t0, t1] to where a t^2 + 2 b t + c < 0 (a > 0); whether any of it is left.
+bool insideQuadratic(double a, double b, double c, double& t0, double& t1) {
+  const double disc = b * b - a * c;
+  if (!(disc > 0)) return false;
+  const double q = std::sqrt(disc);
+  t0 = std::max(t0, (-b - q) / a);
+  t1 = std::min(t1, (-b + q) / a);
+  return t0 < t1;
+}
+
+}  // namespace
+
 bool pointSurelyOutside(const Shape& s, const Vec3& pf, float margin) {
   if (!canProveMeets(s) || !(margin >= 0)) return false;
   const auto& L = s.toLocal.m;
@@ -327,29 +341,17 @@ bool segmentSurelyMeets(const Shape& s, const Vec3& of, const Vec3& df, float tL
       t1 = std::min(t1, tb);
     }
     const double a = d[0] * d[0] + d[1] * d[1];
-    const double b = o[0] * d[0] + o[1] * d[1];
     const double c = o[0] * o[0] + o[1] * o[1] - r * r;
     if (a == 0) return c < 0 && t0 < t1;  // along the axis: inside the radius throughout
-    const double disc = b * b - a * c;
-    if (!(disc > 0)) return false;
-    const double q = std::sqrt(disc);
-    t0 = std::max(t0, (-b - q) / a);
-    t1 = std::min(t1, (-b + q) / a);
-    return t0 < t1;
+    return insideQuadratic(a, o[0] * d[0] + o[1] * d[1], c, t0, t1);
   }
   // The unit sphere shrunk to radius 1 - depth: |o + t d|^2 < r^2 on an open interval.
   const double r = 1 - double(margin) * std::sqrt(f2) - 1e-6;
   if (!(r > 0)) return false;
   const double a = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
   if (!(a > 0)) return false;
-  const double b = o[0] * d[0] + o[1] * d[1] + o[2] * d[2];
-  const double c = o[0] * o[0] + o[1] * o[1] + o[2] * o[2] - r * r;
-  const double disc = b * b - a * c;
-  if (!(disc > 0)) return false;
-  const double q = std::sqrt(disc);
-  t0 = std::max(t0, (-b - q) / a);
-  t1 = std::min(t1, (-b + q) / a);
-  return t0 < t1;
+  return insideQuadratic(a, o[0] * d[0] + o[1] * d[1] + o[2] * d[2], o[0] * o[0] + o[1] * o[1] + o[2] * o[2] - r * r,
+                         t0, t1);
 }
 
 bool isConvexShape(const Shape& s, const Mesh* mesh) {
