@@ -97,18 +97,17 @@ bool ShadowRays::blockerBox(int blocker, Vec3& lo, Vec3& hi) const {
 // distance form a convex cone): one that passes through the blocker 4 eps deep (plus the
 // coordinates' rounding), from that margin past p to that margin before tMax, stops the
 // rays too. Boxes, spheres and capped cylinders are decided exactly
-// (scene::segmentSurelyMeets); other shapes are left to the rays.
+// (scene::SolidWithMargin); other shapes are left to the rays.
 int ShadowRays::blocksAll(int blocker, const Vec3* dirs, int n, float tMax) const {
   if (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)) return -1;
-  const scene::Shape& s = scene_.shapes()[size_t(blocker)];
-  if (!scene::canProveMeets(s)) return -1;
   const float margin = 4 * eps_ + 1e-5f * (length(p_) + tMax);
   if (!std::isfinite(margin)) return -1;
+  const scene::SolidWithMargin solid(scene_.shapes()[size_t(blocker)], margin);
   // From inside the shape (a room modelled as one box, seen from within) a segment runs
   // through it without crossing its surface: the rays decide, as before.
-  if (!scene::pointSurelyOutside(s, p_, margin)) return -1;
+  if (!solid.decides() || !solid.surelyOutside(p_)) return -1;
   for (int i = 0; i < n; ++i)
-    if (!scene::segmentSurelyMeets(s, p_, dirs[i], margin, tMax - margin, margin)) return 0;
+    if (!solid.surelyMeets(p_, dirs[i], margin, tMax - margin)) return 0;
   return 1;
 }
 

@@ -267,53 +267,60 @@ bool insideQuadratic(double a, double b, double c, double& t0, double& t1) {
 
 }  // namespace
 
-bool pointSurelyOutside(const Shape& s, const Vec3& pf, float margin) {
-  if (!canProveMeets(s) || !(margin >= 0)) return false;
-  const auto& L = s.toLocal.m;
-  double x[3], row[3], f2 = 0;
+SolidWithMargin::SolidWithMargin(const Shape& s, float margin) : s_(s), m_(double(margin)) {
+  decides_ = canProveMeets(s) && margin >= 0;
+  // A world displacement of length m moves local coordinate i by at most m times the norm
+  // of row i of toLocal, and the local point by at most m times the Frobenius norm.
+  double f2 = 0;
   for (int i = 0; i < 3; ++i) {
-    const auto& r = L[size_t(i)];
-    x[i] = r[0] * pf.x + r[1] * pf.y + r[2] * pf.z + r[3];
+    const auto& r = s.toLocal.m[size_t(i)];
     const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    row[i] = std::sqrt(r2);
+    row_[i] = std::sqrt(r2);
     f2 += r2;
   }
-  const double m = double(margin);
-  switch (s.kind) {
+  radial_ = std::sqrt(row_[0] * row_[0] + row_[1] * row_[1]);
+  frobenius_ = std::sqrt(f2);
+}
+
+void SolidWithMargin::toLocal(const Vec3& p, double* x) const {
+  for (int i = 0; i < 3; ++i) {
+    const auto& r = s_.toLocal.m[size_t(i)];
+    x[i] = r[0] * p.x + r[1] * p.y + r[2] * p.z + r[3];
+  }
+}
+
+bool SolidWithMargin::surelyOutside(const Vec3& p) const {
+  if (!decides_) return false;
+  double x[3];
+  toLocal(p, x);
+  switch (s_.kind) {
     case io::ShapeKind::Box:
       for (int i = 0; i < 3; ++i)
-        if (std::fabs(x[i]) > 0.5 + m * row[i] + 1e-6) return true;
+        if (std::fabs(x[i]) > 0.5 + m_ * row_[i] + 1e-6) return true;
       return false;
     case io::ShapeKind::Cylinder: {
-      const double grow = m * std::sqrt(row[0] * row[0] + row[1] * row[1]) + 1e-6;
-      const double zGrow = m * row[2] + 1e-6;
+      const double grow = m_ * radial_ + 1e-6, zGrow = m_ * row_[2] + 1e-6;
       return x[0] * x[0] + x[1] * x[1] > (1 + grow) * (1 + grow) || x[2] < -zGrow || x[2] > 1 + zGrow;
     }
     default: {
-      const double R = 1 + m * std::sqrt(f2) + 1e-6;
+      const double R = 1 + m_ * frobenius_ + 1e-6;
       return x[0] * x[0] + x[1] * x[1] + x[2] * x[2] > R * R;
     }
   }
 }
 
-bool segmentSurelyMeets(const Shape& s, const Vec3& of, const Vec3& df, float tLo, float tHi, float margin) {
-  if (!canProveMeets(s) || !(tLo <= tHi) || !(margin >= 0)) return false;
-  const auto& L = s.toLocal.m;
-  // A world displacement of length m moves local coordinate i by at most m times the norm
-  // of row i of toLocal, and the local point by at most m times the Frobenius norm.
-  double o[3], d[3], row[3], f2 = 0;
+bool SolidWithMargin::surelyMeets(const Vec3& of, const Vec3& df, float tLo, float tHi) const {
+  if (!decides_ || !(tLo <= tHi)) return false;
+  double o[3], d[3];
+  toLocal(of, o);
   for (int i = 0; i < 3; ++i) {
-    const auto& r = L[size_t(i)];
-    o[i] = r[0] * of.x + r[1] * of.y + r[2] * of.z + r[3];
+    const auto& r = s_.toLocal.m[size_t(i)];
     d[i] = r[0] * df.x + r[1] * df.y + r[2] * df.z;
-    const double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    row[i] = std::sqrt(r2);
-    f2 += r2;
   }
   double t0 = tLo, t1 = tHi;
-  if (s.kind == io::ShapeKind::Box) {
+  if (s_.kind == io::ShapeKind::Box) {
     for (int i = 0; i < 3; ++i) {
-      const double h = 0.5 - double(margin) * row[i] - 1e-6;  // the slab shrunk by the depth
+      const double h = 0.5 - m_ * row_[i] - 1e-6;  // the slab shrunk by the depth
       if (!(h > 0)) return false;
       if (d[i] == 0) {
         if (o[i] <= -h || o[i] >= h) return false;
@@ -326,11 +333,11 @@ bool segmentSurelyMeets(const Shape& s, const Vec3& of, const Vec3& df, float tL
     }
     return t0 < t1;
   }
-  if (s.kind == io::ShapeKind::Cylinder) {
+  if (s_.kind == io::ShapeKind::Cylinder) {
     // The solid x^2 + y^2 <= 1, 0 <= z <= 1, shrunk: its radius by the depth in x and y
     // together, its height by the depth in z at each cap.
-    const double r = 1 - double(margin) * std::sqrt(row[0] * row[0] + row[1] * row[1]) - 1e-6;
-    const double zLo = double(margin) * row[2] + 1e-6, zHi = 1 - zLo;
+    const double r = 1 - m_ * radial_ - 1e-6;
+    const double zLo = m_ * row_[2] + 1e-6, zHi = 1 - zLo;
     if (!(r > 0) || !(zLo < zHi)) return false;
     if (d[2] == 0) {
       if (o[2] <= zLo || o[2] >= zHi) return false;
@@ -346,7 +353,7 @@ bool segmentSurelyMeets(const Shape& s, const Vec3& of, const Vec3& df, float tL
     return insideQuadratic(a, o[0] * d[0] + o[1] * d[1], c, t0, t1);
   }
   // The unit sphere shrunk to radius 1 - depth: |o + t d|^2 < r^2 on an open interval.
-  const double r = 1 - double(margin) * std::sqrt(f2) - 1e-6;
+  const double r = 1 - m_ * frobenius_ - 1e-6;
   if (!(r > 0)) return false;
   const double a = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
   if (!(a > 0)) return false;

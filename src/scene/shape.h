@@ -58,20 +58,34 @@ Bounds3 quadricLocalBounds(const Shape& s);
 // World bounds of a quadric (its local bounding box, transformed).
 Bounds3 quadricBounds(const Shape& s);
 
-// Whether the segment o + t d (world space), t in [tLo, tHi], certainly passes through the
-// inside of shape s at depth `margin` (world units) or more: some point of it has the whole
-// ball of that radius inside the shape. Exact for boxes, spheres and capped cylinders under
-// any affine transform (in double, the depth taken in local units through a bound on
-// toLocal's stretch); false for every other kind, which the caller tells by canProveMeets.
-bool segmentSurelyMeets(const Shape& s, const Vec3& o, const Vec3& d, float tLo, float tHi, float margin);
-// Whether p lies outside shape s grown by `margin` (world units), for the kinds
-// segmentSurelyMeets decides (false for the others). A segment from a point inside a solid
-// runs through it without crossing its surface, which is what stops a ray.
-bool pointSurelyOutside(const Shape& s, const Vec3& p, float margin);
+// The kinds SolidWithMargin decides.
 inline bool canProveMeets(const Shape& s) {
   return s.kind == io::ShapeKind::Box || s.kind == io::ShapeKind::Sphere ||
          (s.kind == io::ShapeKind::Cylinder && s.capped);
 }
+// Box, sphere or capped cylinder s with a margin (world units), for proofs that need no
+// ray (the visibility probes). Exact under any affine transform, in double: a world
+// displacement of length m moves local coordinate i by at most m times the norm of row i of
+// toLocal, so the margin becomes local depths once, here. For other kinds (canProveMeets)
+// both tests answer false.
+class SolidWithMargin {
+ public:
+  SolidWithMargin(const Shape& s, float margin);
+  bool decides() const { return decides_; }
+  // Whether p lies outside the shape grown by the margin. A segment from a point inside a
+  // solid runs through it without crossing its surface, which is what stops a ray.
+  bool surelyOutside(const Vec3& p) const;
+  // Whether the segment o + t d (world space), t in [tLo, tHi], passes through the shape
+  // shrunk by the margin: some point of it has the whole ball of that radius inside.
+  bool surelyMeets(const Vec3& o, const Vec3& d, float tLo, float tHi) const;
+
+ private:
+  void toLocal(const Vec3& p, double* x) const;
+  const Shape& s_;
+  double m_;
+  double row_[3], radial_, frobenius_;  // toLocal's row norms, of x and y together, of all
+  bool decides_;
+};
 
 // Whether the shape is a convex solid (sphere, box, capped cylinder or cone, a closed
 // mesh with every vertex behind every face's plane) or a flat convex polygon (square, a

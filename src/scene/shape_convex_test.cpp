@@ -1,5 +1,5 @@
 // isConvexShape: which shapes the visibility probes may treat as convex occluders; and
-// segmentSurelyMeets, which lets a probe prove a box or sphere in the way without rays.
+// SolidWithMargin, which lets a probe prove a box or sphere in the way without rays.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -117,7 +117,7 @@ bool hits(const Shape& s, const Vec3& o, const Vec3& d, float t0, float t1) {
   return inside || intersectQuadric(s, lo, ld, t0, t1, t, part);
 }
 
-// segmentSurelyMeets claims a segment only when every segment within `margin` of it meets
+// SolidWithMargin claims a segment only when every segment within `margin` of it meets
 // the shape too (the shadow rays a probe stands for leave from near the point), and never
 // when it misses or only grazes the shape.
 TEST(ShapeMeets, SegmentsClaimedPassDeepThroughBoxesSpheresAndCylinders) {
@@ -133,7 +133,7 @@ TEST(ShapeMeets, SegmentsClaimedPassDeepThroughBoxesSpheresAndCylinders) {
       const float len = length(aim - o);
       const Vec3 d = (aim - o) / len;
       const float t1 = len * 1.5f;
-      if (!segmentSurelyMeets(s, o, d, 0, t1, margin)) {
+      if (!SolidWithMargin(s, margin).surelyMeets(o, d, 0, t1)) {
         missed += !hits(s, o, d, 0, t1);
         continue;
       }
@@ -157,25 +157,25 @@ TEST(ShapeMeets, SegmentsClaimedPassDeepThroughBoxesSpheresAndCylinders) {
     const Shape s = placed(kind);
     const Vec3 centre = s.toWorld.point(kind == io::ShapeKind::Cylinder ? Vec3(0, 0, 0.5f) : Vec3(0));
     const Vec3 surface = s.toWorld.point(kind == io::ShapeKind::Cylinder ? Vec3(1, 0, 0.5f) : Vec3(0.5f, 0, 0));
-    EXPECT_FALSE(pointSurelyOutside(s, centre, margin)) << int(kind);
-    EXPECT_FALSE(pointSurelyOutside(s, surface, margin)) << int(kind);
-    EXPECT_TRUE(pointSurelyOutside(s, centre + Vec3(20, 0, 0), margin)) << int(kind);
+    EXPECT_FALSE(SolidWithMargin(s, margin).surelyOutside(centre)) << int(kind);
+    EXPECT_FALSE(SolidWithMargin(s, margin).surelyOutside(surface)) << int(kind);
+    EXPECT_TRUE(SolidWithMargin(s, margin).surelyOutside(centre + Vec3(20, 0, 0))) << int(kind);
   }
   // The unit box, as given: a segment through its middle is claimed, one that passes
   // within the margin of a face is not, nor one that ends before the box or starts after it.
   Shape box;
   box.kind = io::ShapeKind::Box;
-  EXPECT_TRUE(segmentSurelyMeets(box, Vec3(-2, 0, 0), Vec3(1, 0, 0), 0, 4, 0.01f));
-  EXPECT_FALSE(segmentSurelyMeets(box, Vec3(-2, 0.495f, 0), Vec3(1, 0, 0), 0, 4, 0.01f));
-  EXPECT_FALSE(segmentSurelyMeets(box, Vec3(-2, 0, 0), Vec3(1, 0, 0), 0, 1.4f, 0.2f));
-  EXPECT_FALSE(segmentSurelyMeets(box, Vec3(-2, 0, 0), Vec3(1, 0, 0), 2.6f, 4, 0.2f));
+  EXPECT_TRUE(SolidWithMargin(box, 0.01f).surelyMeets(Vec3(-2, 0, 0), Vec3(1, 0, 0), 0, 4));
+  EXPECT_FALSE(SolidWithMargin(box, 0.01f).surelyMeets(Vec3(-2, 0.495f, 0), Vec3(1, 0, 0), 0, 4));
+  EXPECT_FALSE(SolidWithMargin(box, 0.2f).surelyMeets(Vec3(-2, 0, 0), Vec3(1, 0, 0), 0, 1.4f));
+  EXPECT_FALSE(SolidWithMargin(box, 0.2f).surelyMeets(Vec3(-2, 0, 0), Vec3(1, 0, 0), 2.6f, 4));
   // Shapes it does not decide: flat ones, open tubes, cones, meshes.
   for (io::ShapeKind kind : {io::ShapeKind::Square, io::ShapeKind::Cylinder, io::ShapeKind::Cone, io::ShapeKind::Mesh}) {
     Shape other;
     other.kind = kind;
     other.capped = kind != io::ShapeKind::Cylinder;
     EXPECT_FALSE(canProveMeets(other));
-    EXPECT_FALSE(segmentSurelyMeets(other, Vec3(-2, 0, 0.5f), Vec3(1, 0, 0), 0, 4, 0.01f));
+    EXPECT_FALSE(SolidWithMargin(other, 0.01f).surelyMeets(Vec3(-2, 0, 0.5f), Vec3(1, 0, 0), 0, 4));
   }
 }
 
