@@ -34,6 +34,7 @@ const char* shapeName(io::ShapeKind k) {
 int runInfo(InfoArgs& a) {
   a.load.quiet = true;
   a.load.occluders = false;  // nothing here asks whether shadow rays are clear
+  a.load.planarFaces = false;
   LoadedScene ls = loadScene(a.scene, a.load);
   const scene::Scene& s = *ls.scene;
   std::map<std::string, int> shapes;

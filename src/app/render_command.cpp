@@ -335,6 +335,8 @@ bool setUpRender(RenderArgs& a, Cluster* cluster, RenderSetup& s) {
   a.load.linearizeSrgbTextures = a.tonemap != io::ToneMap::Clamp;
   // Only lightcuts' clear clusters query the occluder index (scene/occluders.h).
   a.load.occluders = a.method == lightcuts::Method::Lightcuts && a.clearClusters;
+  // and only its visibility probes ask about the meshes' flat faces (scene/planar_faces.h).
+  a.load.planarFaces = a.method == lightcuts::Method::Lightcuts && a.visibilityProbes;
   a.load.quiet = a.quiet;
   a.load.interruptible = true;
   try {
@@ -658,8 +660,9 @@ void addRenderCommand(CLI::App& app) {
       ->group(cuts);
   addSwitch(*c, "--visibility-probes", a->visibilityProbes,
             fmt::format("Lightcuts: before refining a cluster whose representative is hidden, test the corners of "
-                        "its box (boxes, spheres and capped cylinders answer without rays); when one convex object "
-                        "hides them all, the cluster stays in the cut as hidden (on) or not (off, as published); "
+                        "its box (boxes, spheres, capped cylinders and the flat faces of meshes answer without rays); "
+                        "when one convex object hides them all, the cluster stays in the cut as hidden (on) or not "
+                        "(off, as published); "
                         "default {}", switchName(d.visibilityProbes)))
       ->group(cuts);
   addSwitch(*c, "--clear-clusters", a->clearClusters,

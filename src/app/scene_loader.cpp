@@ -41,6 +41,7 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
   bo.threads = o.threads;
   bo.linearizeSrgbTextures = o.linearizeSrgbTextures;
   bo.occluders = o.occluders;
+  bo.planarFaces = o.planarFaces;
   out.scene = scene::Scene::build(desc, bo);
   out.accelSeconds = since(t1);
 

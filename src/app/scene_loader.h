@@ -46,6 +46,8 @@ struct LoadOptions {
   bool linearizeSrgbTextures = false;
   // scene::BuildOptions::occluders: for lightcuts with --clear-clusters on.
   bool occluders = true;
+  // scene::BuildOptions::planarFaces: for lightcuts with --visibility-probes on.
+  bool planarFaces = true;
   bool quiet = false;
   // SIGINT/SIGTERM stop the object lights and VPLs (app/interrupt.h): loadScene then throws
   // lc::Interrupted. Off, the signals keep their default effect.

@@ -36,8 +36,9 @@ class Visibility {
   // wi: unit direction to the light; dist: distance to it (infinity for directional).
   virtual Color operator()(const Vec3& wi, float dist) = 0;
   // As operator(), and what stopped the ray: `blocker` is kVisible when nothing opaque
-  // did, the index of a convex opaque object that did, with the distance to it in
-  // `tHit`, or kUnknownBlocker (a non-convex or unknown occluder). A convex object that
+  // did, the index of a convex opaque object that did (the renderer numbers convex shapes,
+  // then the flat convex faces of meshes), with the distance to it in `tHit`, or
+  // kUnknownBlocker (a non-convex or unknown occluder). A convex object that
   // blocks a set of directions blocks their convex hull too, which is what the visibility
   // probes (evaluator.h) build on.
   static constexpr int kVisible = -1;

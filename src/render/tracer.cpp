@@ -53,14 +53,22 @@ Color ShadowRays::trace(const Vec3& wi, float dist, int& blocker, float& tHit) {
     blocker = kVisible;
     tHit = 0;
     if (!(tmax > 0)) return Color(1);
-    int shape = scene_.firstHit(o, dir, tmax, tHit);
+    int prim = 0;
+    int shape = scene_.firstHit(o, dir, tmax, tHit, &prim);
     if (shape < 0) return Color(1);
     if (scene_.isTransmissive(shape)) {  // glass on the way: the walk through it decides
       Color v = scene_.transmittance(o, dir, tmax);
       blocker = isBlack(v) ? kUnknownBlocker : kVisible;
       return v;
     }
-    blocker = scene_.isConvex(shape) ? shape : kUnknownBlocker;
+    if (scene_.isConvex(shape)) {
+      blocker = shape;
+    } else {
+      // A triangle of a non-convex mesh: the flat convex face it is part of, numbered
+      // after the shapes.
+      const int face = scene_.planarFaces().faceOf(shape, prim);
+      blocker = face >= 0 ? int(scene_.shapes().size()) + face : kUnknownBlocker;
+    }
     return Color(0);
   });
 }
@@ -80,8 +88,10 @@ bool ShadowRays::boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) {
 // 2 eps of the segment from p the probe tests; the bounds are padded by that and by their
 // own float rounding.
 bool ShadowRays::blockerBox(int blocker, Vec3& lo, Vec3& hi) const {
-  if (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)) return false;
-  const Bounds3& b = scene_.convexBounds(blocker);
+  const int face = faceOf(blocker);
+  if (face < 0 && (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)))
+    return false;
+  const Bounds3& b = face >= 0 ? scene_.planarFaces().bounds(face) : scene_.convexBounds(blocker);
   if (b.empty()) return false;
   const Vec3 big = vmax(vabs(b.lo), vabs(b.hi));
   const float pad = 4 * eps_ + 1e-5f * std::max({big.x, big.y, big.z, length(p_)});
@@ -97,11 +107,16 @@ bool ShadowRays::blockerBox(int blocker, Vec3& lo, Vec3& hi) const {
 // distance form a convex cone): one that passes through the blocker 4 eps deep (plus the
 // coordinates' rounding), from that margin past p to that margin before tMax, stops the
 // rays too. Boxes, spheres and capped cylinders are decided exactly
-// (scene::SolidWithMargin); other shapes are left to the rays.
+// (scene::SolidWithMargin), and so are the flat faces of meshes (scene::PlanarFaces, which
+// widens the margin by 1/cos of the crossing's slant: a flat face has no depth); other
+// shapes are left to the rays.
 int ShadowRays::blocksAll(int blocker, const Vec3* dirs, int n, float tMax) const {
-  if (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)) return -1;
   const float margin = 4 * eps_ + 1e-5f * (length(p_) + tMax);
   if (!std::isfinite(margin)) return -1;
+  // A mesh's flat face: every segment crosses it well inside its edges (planar_faces.h).
+  if (const int face = faceOf(blocker); face >= 0)
+    return scene_.planarFaces().crossesAll(face, p_, dirs, n, tMax, margin);
+  if (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)) return -1;
   const scene::SolidWithMargin solid(scene_.shapes()[size_t(blocker)], margin);
   // From inside the shape (a room modelled as one box, seen from within) a segment runs
   // through it without crossing its surface: the rays decide, as before.

@@ -35,6 +35,13 @@ class ShadowRays final : public lightcuts::Visibility {
   bool boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) override;
   bool blockerBox(int blocker, Vec3& lo, Vec3& hi) const override;
   int blocksAll(int blocker, const Vec3* dirs, int n, float tMax) const override;
+  // The flat face (scene::PlanarFaces) a blocker number names, or -1 (a shape's number).
+  int faceOf(int blocker) const {
+    const size_t shapes = scene_.shapes().size();
+    return blocker >= 0 && size_t(blocker) >= shapes && size_t(blocker) - shapes < scene_.planarFaces().size()
+               ? int(size_t(blocker) - shapes)
+               : -1;
+  }
 
  private:
   Vec3 origin(const Vec3& wi, float dist, float& tmax, Vec3& dir) const;

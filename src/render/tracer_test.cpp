@@ -7,7 +7,10 @@
 #include <memory>
 
 #include "io/ray_parser.h"
+#include "lightcuts/evaluator.h"
+#include "lightcuts/light_tree.h"
 #include "scene/scene.h"
+#include "test_lights.h"
 
 namespace lc::render {
 namespace {
@@ -154,6 +157,66 @@ translate(0, 1, -3, scale(2, 2, 0.2, box { material = white; }))
   // One whose corners pass above it: not proven.
   dirsTo(Vec3(-0.2f, 2.8f, -4.0f), Vec3(0.2f, 3.2f, -3.8f), dirs, dMin);
   EXPECT_EQ(vis.blocksAll(1, dirs, 8, dMin), 0);
+}
+
+// A canopy (a slab with a slanted edge) and a wall written as one triangle mesh (not convex as a whole): a shadow ray
+// stopped by it names the flat face it met (scene::PlanarFaces), whose bounds hold the hit,
+// and that face decides the probes without rays. With a zero threshold every cluster not
+// proven hidden is refined to its lights, so the cut must equal brute force.
+TEST(ShadowRays, AMeshsFlatFacesDecideProbesAndTheCutStaysExact) {
+  auto scene = scene::Scene::build(io::parseRayString(R"(SBT-raytracer 1.0
+material = { name = white; diffuse = (0.5, 0.5, 0.5); }
+translate(0, -0.05, 0, scale(20, 0.1, 20, box { material = white; }))
+trimesh { material = white;
+  points = ((-3, 1.4, -3), (0.2, 1.4, -3), (1.5, 1.4, 3), (-3, 1.4, 3),
+            (-3, 1.5, -3), (0.2, 1.5, -3), (1.5, 1.5, 3), (-3, 1.5, 3),
+            (0.8, 0, -3), (0.9, 0, -3), (0.9, 0, 3), (0.8, 0, 3),
+            (0.8, 1.2, -3), (0.9, 1.2, -3), (0.9, 1.2, 3), (0.8, 1.2, 3));
+  faces = ((0, 2, 1), (0, 3, 2), (4, 5, 6), (4, 6, 7), (0, 1, 5), (0, 5, 4), (1, 2, 6), (1, 6, 5),
+           (2, 3, 7), (2, 7, 6), (3, 0, 4), (3, 4, 7),
+           (8, 10, 9), (8, 11, 10), (12, 13, 14), (12, 14, 15), (8, 9, 13), (8, 13, 12), (9, 10, 14),
+           (9, 14, 13), (10, 11, 15), (10, 15, 14), (11, 8, 12), (11, 12, 15)); }
+)",
+                                                      "canopy.ray", ""));
+  ASSERT_FALSE(scene->isConvex(1));
+  ASSERT_EQ(scene->planarFaces().size(), 12u);
+  scene::Hit h;
+  ASSERT_TRUE(scene->intersect(scene::Ray{Vec3(-1, 1, 0.3f), Vec3(0, -1, 0)}, h));
+  ShadowRays vis(*scene, h);
+  const Vec3 d = normalize(Vec3(-1.5f, 2.5f, 0) - h.p);
+  int blocker;
+  float tHit;
+  vis.trace(d, 3, blocker, tHit);
+  ASSERT_GE(blocker, 2);  // a face, numbered after the two shapes
+  Vec3 lo, hi;
+  ASSERT_TRUE(vis.blockerBox(blocker, lo, hi));
+  const Vec3 q = h.p + d * tHit;
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_GE(q[a], lo[a]);
+    EXPECT_LE(q[a], hi[a]);
+  }
+
+  using namespace lightcuts;
+  LightSet s = test_lights::cloud(3000, LightType::Omni, 27);
+  LightForest f = buildLightForest(s);
+  CutOptions o;
+  o.errorRatio = 0;
+  o.maxCut = 1 << 20;
+  o.visibilityProbes = true;
+  auto lcut = makeLightcuts(s, f, o);
+  auto bf = makeBruteForce(s);
+  EvalStats st, sb;
+  for (int i = 0; i < 6; ++i) {
+    ASSERT_TRUE(scene->intersect(scene::Ray{Vec3(0.4f * float(i) - 2.2f, 1, 0.2f * float(i) - 0.4f), Vec3(0, -1, 0)}, h));
+    ShadowRays v(*scene, h);
+    ShadingPoint sp = test_lights::point(h.p);
+    const Color want = bf->evaluate(sp, v, sb).radiance;
+    const Color got = lcut->evaluate(sp, v, st).radiance;
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], 1e-5f * (want[k] + 1e-6f)) << i;
+  }
+  EXPECT_GT(st.hiddenClusters, 0u);
+  EXPECT_EQ(st.probeRays, 0u);
+  EXPECT_LT(st.shadowRays, sb.shadowRays / 2);
 }
 
 }  // namespace

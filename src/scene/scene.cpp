@@ -349,6 +349,7 @@ void Scene::buildGeometry(const BuildOptions& options) {
   RTCError err = rtcGetDeviceError(device_);
   if (err != RTC_ERROR_NONE) throw Error(fmt::format("Embree failed to build the scene (error {})", int(err)));
   if (options.occluders) occluders_ = OccluderIndex(shapes_, meshes_);
+  if (options.planarFaces) planarFaces_ = PlanarFaces(shapes_, meshes_);
 }
 
 size_t Scene::triangleCount() const {
@@ -425,7 +426,7 @@ bool Scene::occluded(const Vec3& origin, const Vec3& dir, float tmax) const {
   return r.tfar < 0;
 }
 
-int Scene::firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t) const {
+int Scene::firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t, int* prim) const {
   RTCIntersectContext ctx;
   if (!rayIsValid(origin, dir, 0, tmax)) return -1;
   rtcInitIntersectContext(&ctx);
@@ -433,6 +434,7 @@ int Scene::firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t) c
   rtcIntersect1(rtc_, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return -1;
   t = rh.ray.tfar;
+  if (prim) *prim = int(rh.hit.primID);
   return int(rh.hit.geomID);
 }
 

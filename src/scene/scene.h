@@ -17,6 +17,7 @@
 #include "core/light.h"
 #include "scene/material.h"
 #include "scene/occluders.h"
+#include "scene/planar_faces.h"
 #include "scene/shape.h"
 
 namespace lc::scene {
@@ -50,6 +51,10 @@ struct BuildOptions {
   // it no cluster is known clear. About 24 bytes per triangle; the CLI leaves it out
   // where nothing will query it (brute force, --clear-clusters off).
   bool occluders = true;
+  // Split the meshes into flat convex faces (planar_faces.h), which lightcuts' visibility
+  // probes ask whether they hide a cluster. About 4 bytes per triangle and 100 per face;
+  // the CLI leaves them out where nothing will ask (brute force, --visibility-probes off).
+  bool planarFaces = true;
 };
 
 class Scene {
@@ -69,7 +74,8 @@ class Scene {
   // Binary visibility, the fast path for scenes without transmissive materials.
   bool occluded(const Vec3& origin, const Vec3& dir, float tmax) const;
   // The nearest surface along the segment: its shape index and distance, or -1.
-  int firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t) const;
+  // `prim`, when given, receives the triangle's index within a mesh (0 for quadrics).
+  int firstHit(const Vec3& origin, const Vec3& dir, float tmax, float& t, int* prim = nullptr) const;
   bool hasTransmissive() const { return hasTransmissive_; }
   // Off, shadow rays treat transmissive surfaces as opaque (transmittance() is 0 or 1 and
   // isTransmissive() is false): with caustics on, the light that passes glass is carried by
@@ -86,6 +92,8 @@ class Scene {
   bool isTransmissive(int shape) const { return shadowsThroughGlass_ && transmissive_[size_t(shape)] != 0; }
   // Every surface as convex pieces, for proving a set of segments clear (occluders.h).
   const OccluderIndex& occluders() const { return occluders_; }
+  // The meshes' flat convex faces (empty unless BuildOptions::planarFaces).
+  const PlanarFaces& planarFaces() const { return planarFaces_; }
 
   // Material values at a hit (textures looked up, per-vertex materials blended).
   ShadingMaterial shadingMaterial(const Hit& hit) const;
@@ -138,6 +146,7 @@ class Scene {
   std::vector<Bounds3> convexBounds_;  // per shape: its world bounds if convex, else empty
   std::vector<uint8_t> transmissive_;  // per shape
   OccluderIndex occluders_;
+  PlanarFaces planarFaces_;
   RTCDevice device_ = nullptr;
   RTCScene rtc_ = nullptr;
 };

@@ -1,0 +1,175 @@
+#include "scene/planar_faces.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace lc::scene {
+
+namespace {
+
+struct D3 {
+  double x, y, z;
+};
+D3 d3(const Vec3& v) { return {v.x, v.y, v.z}; }
+D3 sub(const D3& a, const D3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+D3 crossd(const D3& a, const D3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double dotd(const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+double lend(const D3& a) { return std::sqrt(dotd(a, a)); }
+
+// Relative tolerances: a neighbour is coplanar when its normal is within ~0.1 mrad and its
+// corners within kPlaneTol of the face's extent off its plane; a corner is convex unless its
+// turn is more than kTurnTol (relative) the other way.
+constexpr double kNormalTol = 1e-8;  // 1 - |cos| of the angle between the normals
+constexpr double kPlaneTol = 1e-6;
+constexpr double kTurnTol = 1e-9;
+
+}  // namespace
+
+PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mesh>& meshes) {
+  firstTriangle_.assign(shapes.size(), -1);
+  size_t total = 0;
+  for (const Shape& s : shapes)
+    if (s.kind == io::ShapeKind::Mesh) total += meshes[size_t(s.mesh)].triangles.size();
+  if (total > kMaxTriangles) return;
+  triFace_.reserve(total);
+  std::vector<std::pair<uint64_t, uint32_t>> edgeTris;  // (vertex pair, triangle), sorted
+  std::vector<uint32_t> stack, members;
+  std::vector<int> poly;
+  for (size_t si = 0; si < shapes.size(); ++si) {
+    if (shapes[si].kind != io::ShapeKind::Mesh) continue;
+    const Mesh& m = meshes[size_t(shapes[si].mesh)];
+    const auto& tri = m.triangles;
+    const auto& v = m.positions;
+    firstTriangle_[si] = int64_t(triFace_.size());
+    const size_t base = triFace_.size();
+    triFace_.resize(base + tri.size(), -1);
+    auto key = [](int a, int b) { return uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b)); };
+    edgeTris.clear();
+    for (uint32_t t = 0; t < tri.size(); ++t)
+      for (int k = 0; k < 3; ++k) edgeTris.push_back({key(tri[t][k], tri[t][(k + 1) % 3]), t});
+    std::sort(edgeTris.begin(), edgeTris.end());
+    auto pushNeighbours = [&](uint32_t t) {
+      for (int k = 0; k < 3; ++k) {
+        const uint64_t e = key(tri[t][k], tri[t][(k + 1) % 3]);
+        auto it = std::lower_bound(edgeTris.begin(), edgeTris.end(), std::make_pair(e, 0u));
+        for (; it != edgeTris.end() && it->first == e; ++it)
+          if (it->second != t && triFace_[base + it->second] < 0) stack.push_back(it->second);
+      }
+    };
+    for (uint32_t seed = 0; seed < tri.size(); ++seed) {
+      if (triFace_[base + seed] >= 0) continue;
+      const D3 a = d3(v[size_t(tri[seed][0])]), b = d3(v[size_t(tri[seed][1])]), c = d3(v[size_t(tri[seed][2])]);
+      D3 n = crossd(sub(b, a), sub(c, a));
+      const double len = lend(n);
+      if (!(len > 0) || !std::isfinite(len)) continue;  // degenerate: no face
+      n = {n.x / len, n.y / len, n.z / len};
+      const double off = dotd(n, a);
+      double extent = std::max({lend(sub(b, a)), lend(sub(c, a)), lend(sub(c, b))});
+      const int face = int(faces_.size());
+      poly.assign({tri[seed][0], tri[seed][1], tri[seed][2]});
+      members.assign({seed});
+      triFace_[base + seed] = face;
+      stack.clear();
+      pushNeighbours(seed);
+      while (!stack.empty() && int(poly.size()) < kMaxCorners) {
+        const uint32_t u = stack.back();
+        stack.pop_back();
+        if (triFace_[base + u] >= 0) continue;
+        const D3 ua = d3(v[size_t(tri[u][0])]), ub = d3(v[size_t(tri[u][1])]), uc = d3(v[size_t(tri[u][2])]);
+        D3 un = crossd(sub(ub, ua), sub(uc, ua));
+        const double ul = lend(un);
+        if (!(ul > 0) || std::fabs(dotd(un, n)) / ul < 1 - kNormalTol) continue;
+        const double tol = kPlaneTol * (extent + std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)}));
+        if (std::fabs(dotd(n, ua) - off) > tol || std::fabs(dotd(n, ub) - off) > tol ||
+            std::fabs(dotd(n, uc) - off) > tol)
+          continue;
+        // The edge u shares with the polygon's boundary, and u's corner across it.
+        bool joined = false;
+        for (int k = 0; k < 3 && !joined; ++k) {
+          const int i = tri[u][k], j = tri[u][(k + 1) % 3], w = tri[u][(k + 2) % 3];
+          const size_t np = poly.size();
+          for (size_t q = 0; q < np; ++q) {
+            const int P = poly[q], Q = poly[(q + 1) % np];
+            if (!((P == i && Q == j) || (P == j && Q == i))) continue;
+            const D3 p = d3(v[size_t(P)]), qv = d3(v[size_t(Q)]), wv = d3(v[size_t(w)]);
+            const D3 prev = d3(v[size_t(poly[(q + np - 1) % np])]), next = d3(v[size_t(poly[(q + 2) % np])]);
+            // Interior is to the left of each edge (counter-clockwise about n): w must lie
+            // strictly to the right of P->Q, and the corners at P and Q stay convex.
+            const D3 pq = sub(qv, p), pw = sub(wv, p);
+            const double side = dotd(n, crossd(pq, pw));
+            if (!(side < -kTurnTol * lend(pq) * lend(pw))) break;
+            const D3 e0 = sub(p, prev), e1 = sub(wv, p), e2 = sub(qv, wv), e3 = sub(next, qv);
+            if (dotd(n, crossd(e0, e1)) < -kTurnTol * lend(e0) * lend(e1)) break;
+            if (dotd(n, crossd(e2, e3)) < -kTurnTol * lend(e2) * lend(e3)) break;
+            poly.insert(poly.begin() + long(q + 1), w);
+            joined = true;
+            break;
+          }
+        }
+        if (!joined) continue;
+        triFace_[base + u] = face;
+        members.push_back(u);
+        extent = std::max({extent, lend(sub(ub, ua)), lend(sub(uc, ua)), lend(sub(uc, ub))});
+        pushNeighbours(u);
+      }
+      // Corners on a straight edge add nothing: drop them.
+      for (size_t q = 0; q < poly.size() && poly.size() > 3;) {
+        const size_t np = poly.size();
+        const D3 p = d3(v[size_t(poly[q])]);
+        const D3 e0 = sub(p, d3(v[size_t(poly[(q + np - 1) % np])])), e1 = sub(d3(v[size_t(poly[(q + 1) % np])]), p);
+        if (std::fabs(dotd(n, crossd(e0, e1))) <= kTurnTol * lend(e0) * lend(e1))
+          poly.erase(poly.begin() + long(q));
+        else
+          ++q;
+      }
+      Face f;
+      f.normal = Vec3(float(n.x), float(n.y), float(n.z));
+      f.offset = float(off);
+      double thick = 0, big = 0;
+      for (uint32_t t : members)
+        for (int k = 0; k < 3; ++k) {
+          const Vec3& x = v[size_t(tri[t][k])];
+          f.box.extend(x);
+          thick = std::max(thick, std::fabs(dotd(n, d3(x)) - off));
+          big = std::max({big, double(std::fabs(x.x)), double(std::fabs(x.y)), double(std::fabs(x.z))});
+        }
+      // The float plane and edges round at about 1e-7 of the coordinates: counted in.
+      f.thickness = float(thick + 1e-6 * big);
+      f.edgeBegin = uint32_t(edges_.size());
+      f.edgeCount = uint32_t(poly.size());
+      for (size_t q = 0; q < poly.size(); ++q) {
+        const D3 p = d3(v[size_t(poly[q])]), qv = d3(v[size_t(poly[(q + 1) % poly.size()])]);
+        D3 in = crossd(n, sub(qv, p));
+        const double il = lend(in);
+        in = {in.x / il, in.y / il, in.z / il};
+        edges_.push_back({Vec3(float(in.x), float(in.y), float(in.z)), float(dotd(in, p))});
+      }
+      faces_.push_back(f);
+    }
+  }
+}
+
+int PlanarFaces::crossesAll(int face, const Vec3& p, const Vec3* dirs, int n, float tMax, float margin) const {
+  const Face& f = faces_[size_t(face)];
+  const float mg = margin + f.thickness;
+  const float sp = dot(f.normal, p) - f.offset;
+  if (!(std::fabs(sp) > mg)) return -1;
+  const float toward = sp > 0 ? -1.0f : 1.0f;
+  float cosMin = 1;
+  for (int i = 0; i < n; ++i) cosMin = std::min(cosMin, toward * dot(f.normal, dirs[i]));
+  // Grazing (or away from the plane): the inset would be huge; not proven.
+  if (!(cosMin > 0.02f)) return 0;
+  const float slide = mg / cosMin;
+  const float inset = mg + slide;
+  const Edge* e = &edges_[f.edgeBegin];
+  for (int i = 0; i < n; ++i) {
+    const float t = std::fabs(sp) / (toward * dot(f.normal, dirs[i]));
+    if (!(t > mg) || !(t + slide < tMax - mg)) return 0;
+    const Vec3 x = p + dirs[i] * t;
+    for (uint32_t k = 0; k < f.edgeCount; ++k)
+      if (!(dot(e[k].inward, x) - e[k].at > inset)) return 0;
+  }
+  return 1;
+}
+
+}  // namespace lc::scene

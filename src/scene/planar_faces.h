@@ -1,0 +1,77 @@
+// Meshes as flat convex faces, for proving light clusters hidden without rays.
+//
+// Lightcuts' visibility probes (evaluator.cpp, "Hidden clusters") prove a cluster hidden
+// when one convex object stops every shadow ray toward its box. Quadrics and whole convex
+// meshes are such objects; a room's walls, slabs and piers written as one triangle mesh
+// are not. But each flat face of such a mesh (a wall's side, a slab's top: coplanar
+// triangles joined along shared edges whose union is a convex polygon) is a convex object
+// too: the directions from a point whose rays cross it form a convex cone. So a shadow ray
+// stopped by a triangle names the face that triangle belongs to, and the probe asks
+// whether every corner's segment crosses that face, well inside its edges.
+//
+// Faces are grown greedily from each triangle across edges it shares (by vertex index)
+// with coplanar triangles, while the polygon stays convex; a triangle no neighbour joins
+// is a face of its own. The polygon is exactly the union of its triangles: a triangle
+// joins across an edge of the polygon's boundary, from outside it, so none overlap.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/math.h"
+#include "scene/shape.h"
+
+namespace lc::scene {
+
+class PlanarFaces {
+ public:
+  // Scenes whose meshes hold more triangles than this in all get no faces (4 bytes per
+  // triangle and about 100 per face, up to ~55 MB here): the probes use rays as before.
+  static constexpr size_t kMaxTriangles = size_t(1) << 19;
+  // A face stops growing at this many corners (a fan of many thin triangles).
+  static constexpr int kMaxCorners = 24;
+
+  PlanarFaces() = default;
+  // The faces of every mesh shape (transmissive ones too: the caller checks materials).
+  PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mesh>& meshes);
+
+  // The face that triangle `prim` of shape `shape` belongs to, or -1.
+  int faceOf(int shape, int prim) const {
+    if (size_t(shape) >= firstTriangle_.size() || firstTriangle_[size_t(shape)] < 0) return -1;
+    return triFace_[size_t(firstTriangle_[size_t(shape)]) + size_t(prim)];
+  }
+  size_t size() const { return faces_.size(); }
+  // The face's bounds (of its corners).
+  const Bounds3& bounds(int face) const { return faces_[size_t(face)].box; }
+  // How far its triangles' corners lie off its plane (rounding of the mesh's coordinates).
+  float thickness(int face) const { return faces_[size_t(face)].thickness; }
+  int corners(int face) const { return int(faces_[size_t(face)].edgeCount); }
+
+  // Whether every segment from p along dirs[0, n) (unit) crosses the face more than
+  // `margin` inside its edges, between `margin` past p and `margin` before tMax, where
+  // segments that run within `margin` of these do the same: 1 yes, 0 not proven, -1 p lies
+  // within the margin of the face's plane (cannot tell). A crossing's inset grows as
+  // 1/cos of the angle to the normal: a segment moved sideways by d meets a plane
+  // crossed at that angle up to d / cos further along it.
+  int crossesAll(int face, const Vec3& p, const Vec3* dirs, int n, float tMax, float margin) const;
+
+ private:
+  struct Face {
+    Vec3 normal;  // unit
+    float offset;  // dot(normal, x) = offset on the plane
+    Bounds3 box;
+    float thickness;
+    uint32_t edgeBegin, edgeCount;
+  };
+  // An edge's inward half-plane within the face's plane: dot(inward, x) >= at inside.
+  struct Edge {
+    Vec3 inward;
+    float at;
+  };
+  std::vector<int64_t> firstTriangle_;  // per shape: offset of its triangles in triFace_, or -1
+  std::vector<int32_t> triFace_;
+  std::vector<Face> faces_;
+  std::vector<Edge> edges_;
+};
+
+}  // namespace lc::scene
