@@ -153,7 +153,10 @@ int PlanarFaces::crossesAll(int face, const Vec3& p, const Vec3* dirs, int n, fl
   const Face& f = faces_[size_t(face)];
   const float mg = margin + f.thickness;
   const float sp = dot(f.normal, p) - f.offset;
-  if (!(std::fabs(sp) > mg)) return -1;
+  // A point within the margin of the plane (on a neighbouring triangle of a bumpy surface,
+  // at the foot of a wall) is not proven: rays would prove it rarely, at up to eight each
+  // (a 200k-triangle terrain sent 1.3 probe rays per shadow ray and rendered 13-30% slower).
+  if (!(std::fabs(sp) > mg)) return 0;
   const float toward = sp > 0 ? -1.0f : 1.0f;
   float cosMin = 1;
   for (int i = 0; i < n; ++i) cosMin = std::min(cosMin, toward * dot(f.normal, dirs[i]));

@@ -49,8 +49,8 @@ class PlanarFaces {
 
   // Whether every segment from p along dirs[0, n) (unit) crosses the face more than
   // `margin` inside its edges, between `margin` past p and `margin` before tMax, where
-  // segments that run within `margin` of these do the same: 1 yes, 0 not proven, -1 p lies
-  // within the margin of the face's plane (cannot tell). A crossing's inset grows as
+  // segments that run within `margin` of these do the same: 1 yes, else 0 (not proven; so
+  // too when p lies within the margin of the face's plane). A crossing's inset grows as
   // 1/cos of the angle to the normal: a segment moved sideways by d meets a plane
   // crossed at that angle up to d / cos further along it.
   int crossesAll(int face, const Vec3& p, const Vec3* dirs, int n, float tMax, float margin) const;

@@ -159,8 +159,8 @@ TEST(PlanarFaces, SegmentsNearClaimedOnesMeetTheFacesTriangles) {
   EXPECT_GT(checked, 2000);
 }
 
-// A point in the face's plane cannot tell (-1); a grazing fan, or one that turns away, is
-// not proven (0); a face beyond tMax is not proven.
+// A point in the face's plane, a grazing fan, one that turns away and a face beyond tMax
+// are not proven.
 TEST(PlanarFaces, PointsInThePlaneGrazingFansAndFarFacesAreNotProven) {
   Mesh m;
   addBox(m, Vec3(-1, 0, -1), Vec3(1, 1, 1));
@@ -171,7 +171,7 @@ TEST(PlanarFaces, PointsInThePlaneGrazingFansAndFarFacesAreNotProven) {
   Vec3 down[1] = {Vec3(0, -1, 0)};
   EXPECT_EQ(f.crossesAll(top, Vec3(0.2f, 3, 0.1f), down, 1, 10, 1e-3f), 1);
   EXPECT_EQ(f.crossesAll(top, Vec3(0.2f, 3, 0.1f), down, 1, 1.5f, 1e-3f), 0);  // stops short
-  EXPECT_EQ(f.crossesAll(top, Vec3(5, 1, 0), down, 1, 10, 1e-3f), -1);         // in the plane
+  EXPECT_EQ(f.crossesAll(top, Vec3(5, 1, 0), down, 1, 10, 1e-3f), 0);          // in the plane
   Vec3 graze[1] = {normalize(Vec3(-1, -0.01f, 0))};
   EXPECT_EQ(f.crossesAll(top, Vec3(2.5f, 1.02f, 0), graze, 1, 10, 1e-3f), 0);
   Vec3 away[1] = {Vec3(0, 1, 0)};
