@@ -261,8 +261,9 @@ TEST(Accuracy, ReconstructionCutsWithinTwoPercentWithFarFewerShadowRays) {
   EXPECT_GT(rec.stats.eval.reconstructedPoints, rec.stats.eval.shadingPoints / 2);
   // Most points borrow visibility: fewer shadow rays than a lightcut at every point (in
   // an image this small, edges, where points need their own cuts, are a large share; the
-  // ratio is 0.70 here, and about a fifth at 512 x 512, docs/BENCHMARKS.md).
-  EXPECT_LT(double(rec.stats.eval.shadowRays), 0.75 * double(full.stats.eval.shadowRays));
+  // ratio is 0.81 here, and about a fifth at 512 x 512, docs/BENCHMARKS.md). It was 0.70
+  // while the full cuts' probes of the blocks, convex meshes, still cost corner rays.
+  EXPECT_LT(double(rec.stats.eval.shadowRays), 0.85 * double(full.stats.eval.shadowRays));
   for (uint8_t d : rec.done) ASSERT_EQ(d, 1);
   EXPECT_EQ(rec.stats.reconstructionCoarseCells, 0u);
 

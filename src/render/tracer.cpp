@@ -107,9 +107,9 @@ bool ShadowRays::blockerBox(int blocker, Vec3& lo, Vec3& hi) const {
 // distance form a convex cone): one that passes through the blocker 4 eps deep (plus the
 // coordinates' rounding), from that margin past p to that margin before tMax, stops the
 // rays too. Boxes, spheres and capped cylinders are decided exactly
-// (scene::SolidWithMargin), and so are the flat faces of meshes (scene::PlanarFaces, which
-// widens the margin by 1/cos of the crossing's slant: a flat face has no depth); other
-// shapes are left to the rays.
+// (scene::SolidWithMargin), and so are closed convex meshes and the flat faces of other
+// meshes (scene::PlanarFaces, which widens a face's margin by 1/cos of the crossing's slant:
+// a flat face has no depth); other shapes are left to the rays.
 int ShadowRays::blocksAll(int blocker, const Vec3* dirs, int n, float tMax) const {
   const float margin = 4 * eps_ + 1e-5f * (length(p_) + tMax);
   if (!std::isfinite(margin)) return -1;
@@ -117,6 +117,9 @@ int ShadowRays::blocksAll(int blocker, const Vec3* dirs, int n, float tMax) cons
   if (const int face = faceOf(blocker); face >= 0)
     return scene_.planarFaces().crossesAll(face, p_, dirs, n, tMax, margin);
   if (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)) return -1;
+  // A convex mesh: its faces' planes, moved in by the margin, clip each segment.
+  if (scene_.shapes()[size_t(blocker)].kind == io::ShapeKind::Mesh)
+    return scene_.planarFaces().solidMeetsAll(blocker, p_, dirs, n, tMax, margin);
   const scene::SolidWithMargin solid(scene_.shapes()[size_t(blocker)], margin);
   // From inside the shape (a room modelled as one box, seen from within) a segment runs
   // through it without crossing its surface: the rays decide, as before.

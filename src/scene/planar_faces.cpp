@@ -1,6 +1,7 @@
 #include "scene/planar_faces.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace lc::scene {
@@ -25,6 +26,85 @@ constexpr double kTurnTol = 1e-9;
 
 }  // namespace
 
+// Whether a mesh bounds a solid: its corners welded by position, every edge joins two
+// triangles (closed), or one triangle along a boundary that lies in one plane (open there:
+// a box standing on the floor without its bottom, as the Cornell box's blocks are), whose
+// plane then closes it. Edges of three triangles or more, or a boundary off one plane: not
+// a solid (`solid` false).
+PlanarFaces::Solid PlanarFaces::solidOf(const Mesh& m) {
+  Solid s;
+  const auto& v = m.positions;
+  if (m.triangles.empty()) return s;
+  std::vector<std::pair<std::array<float, 3>, int>> at(v.size());
+  for (size_t i = 0; i < v.size(); ++i) at[i] = {{v[i].x, v[i].y, v[i].z}, int(i)};
+  std::sort(at.begin(), at.end());
+  std::vector<int> weld(v.size());
+  for (size_t i = 0, id = 0; i < at.size(); ++i) {
+    if (i > 0 && at[i].first != at[i - 1].first) ++id;
+    weld[size_t(at[i].second)] = int(id);
+  }
+  std::vector<uint64_t> edges;
+  edges.reserve(3 * m.triangles.size());
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = weld[size_t(t[k])], b = weld[size_t(t[(k + 1) % 3])];
+      if (a == b) return s;  // a degenerate triangle
+      edges.push_back(uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b)));
+    }
+  std::sort(edges.begin(), edges.end());
+  std::vector<int> rim;  // welded corners on the boundary
+  for (size_t k = 0; k < edges.size();) {
+    size_t e = k;
+    while (e < edges.size() && edges[e] == edges[k]) ++e;
+    if (e - k > 2) return s;
+    if (e - k == 1) {
+      rim.push_back(int(edges[k] >> 32));
+      rim.push_back(int(edges[k] & 0xffffffffu));
+    }
+    k = e;
+  }
+  s.solid = true;
+  if (rim.empty()) return s;
+  // The boundary's plane, from its corners (welded ids back to positions).
+  std::vector<D3> corners;
+  for (size_t i = 0; i < at.size(); ++i)
+    if (std::find(rim.begin(), rim.end(), weld[size_t(at[i].second)]) != rim.end() &&
+        (i == 0 || at[i].first != at[i - 1].first))
+      corners.push_back(d3(v[size_t(at[i].second)]));
+  D3 n{0, 0, 0};
+  double big = 0;
+  for (size_t i = 1; i + 1 < corners.size(); ++i) {
+    const D3 c = crossd(sub(corners[i], corners[0]), sub(corners[i + 1], corners[0]));
+    if (lend(c) > lend(n)) n = c;
+  }
+  for (const D3& c : corners) big = std::max({big, std::fabs(c.x), std::fabs(c.y), std::fabs(c.z)});
+  const double len = lend(n);
+  if (!(len > 0)) {
+    s.solid = false;
+    return s;
+  }
+  n = {n.x / len, n.y / len, n.z / len};
+  const double off = dotd(n, corners[0]);
+  double thick = 0;
+  for (const D3& c : corners) thick = std::max(thick, std::fabs(dotd(n, c) - off));
+  if (thick > kPlaneTol * 1e3 * big) {  // the boundary does not lie in one plane
+    s.solid = false;
+    return s;
+  }
+  // A flat mesh (its boundary's plane holds every corner) bounds nothing.
+  bool flat = true;
+  for (size_t i = 0; i < v.size() && flat; ++i) flat = std::fabs(dotd(n, d3(v[i])) - off) <= 2 * thick + 1e-6 * big;
+  if (flat) {
+    s.solid = false;
+    return s;
+  }
+  s.open = true;
+  s.opening.normal = Vec3(float(n.x), float(n.y), float(n.z));
+  s.opening.offset = float(off);
+  s.opening.thickness = float(thick + 1e-6 * big);
+  return s;
+}
+
 PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mesh>& meshes) {
   firstTriangle_.assign(shapes.size(), -1);
   size_t total = 0;
@@ -48,6 +128,8 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
     for (uint32_t t = 0; t < tri.size(); ++t)
       for (int k = 0; k < 3; ++k) edgeTris.push_back({key(tri[t][k], tri[t][(k + 1) % 3]), t});
     std::sort(edgeTris.begin(), edgeTris.end());
+    Solid solid = solidOf(m);
+    solid.faceBegin = uint32_t(faces_.size());
     auto pushNeighbours = [&](uint32_t t) {
       for (int k = 0; k < 3; ++k) {
         const uint64_t e = key(tri[t][k], tri[t][(k + 1) % 3]);
@@ -146,6 +228,26 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
       }
       faces_.push_back(f);
     }
+    // Each face's normal turned outward: away from the corners' mean, which a closed convex
+    // mesh holds inside.
+    solid.faceEnd = uint32_t(faces_.size());
+    D3 mean{0, 0, 0};
+    for (const Vec3& x : v) mean = {mean.x + x.x, mean.y + x.y, mean.z + x.z};
+    const double nv = double(std::max<size_t>(v.size(), 1));
+    mean = {mean.x / nv, mean.y / nv, mean.z / nv};
+    for (uint32_t k = solid.faceBegin; k < solid.faceEnd; ++k) {
+      Face& f = faces_[k];
+      if (dotd(d3(f.normal), mean) - f.offset > 0) {
+        f.normal = -f.normal;
+        f.offset = -f.offset;
+      }
+    }
+    if (solid.open && dotd(d3(solid.opening.normal), mean) - solid.opening.offset > 0) {
+      solid.opening.normal = -solid.opening.normal;
+      solid.opening.offset = -solid.opening.offset;
+    }
+    solids_.resize(shapes.size());
+    solids_[si] = solid;
   }
 }
 
@@ -171,6 +273,44 @@ int PlanarFaces::crossesAll(int face, const Vec3& p, const Vec3* dirs, int n, fl
     const Vec3 x = p + dirs[i] * t;
     for (uint32_t k = 0; k < f.edgeCount; ++k)
       if (!(dot(e[k].inward, x) - e[k].at > inset)) return 0;
+  }
+  return 1;
+}
+
+int PlanarFaces::solidMeetsAll(int shape, const Vec3& p, const Vec3* dirs, int n, float tMax, float margin) const {
+  if (size_t(shape) >= solids_.size()) return -1;
+  const Solid& s = solids_[size_t(shape)];
+  if (s.faceEnd == s.faceBegin) return -1;
+  if (!s.solid) return s.faceEnd - s.faceBegin == 1 ? crossesAll(int(s.faceBegin), p, dirs, n, tMax, margin) : -1;
+  const uint32_t planes = s.faceEnd - s.faceBegin + (s.open ? 1 : 0);
+  auto plane = [&](uint32_t k) -> const Face& { return k < s.faceEnd - s.faceBegin ? faces_[s.faceBegin + k] : s.opening; };
+  // From outside the solid grown by the margin only (a segment from inside crosses no face).
+  bool outside = false;
+  for (uint32_t k = 0; k < planes && !outside; ++k) {
+    const Face& f = plane(k);
+    outside = dot(f.normal, p) - f.offset > margin + f.thickness;
+  }
+  if (!outside) return -1;
+  // Each segment, clipped by every face's plane moved inward by the margin (and the face's
+  // thickness), must keep a piece between the margin past p and the margin before tMax.
+  // Through an open solid it must also leave before tMax: it then crosses the boundary twice,
+  // in two planes, and the opening lies in one.
+  for (int i = 0; i < n; ++i) {
+    float tIn = margin, tOut = kInf;
+    for (uint32_t k = 0; k < planes && tIn < tOut; ++k) {
+      const Face& f = plane(k);
+      const float room = f.offset - margin - f.thickness - dot(f.normal, p);
+      const float along = dot(f.normal, dirs[i]);
+      if (along > 0) {
+        tOut = std::min(tOut, room / along);
+      } else if (along < 0) {
+        tIn = std::max(tIn, room / along);
+      } else if (room < 0) {
+        return 0;
+      }
+    }
+    if (!(tIn < std::min(tOut, tMax - margin))) return 0;
+    if (s.open && !(tOut < tMax - margin)) return 0;
   }
   return 1;
 }

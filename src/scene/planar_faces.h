@@ -54,6 +54,13 @@ class PlanarFaces {
   // 1/cos of the angle to the normal: a segment moved sideways by d meets a plane
   // crossed at that angle up to d / cos further along it.
   int crossesAll(int face, const Vec3& p, const Vec3* dirs, int n, float tMax, float margin) const;
+  // For a convex mesh shape (Scene::isConvex): whether every segment from p along dirs[0, n)
+  // passes through the solid shrunk by `margin`, between `margin` past p and `margin` before
+  // tMax: 1 yes, 0 not proven, -1 cannot tell (the mesh bounds no solid and is not one
+  // face, or p is not surely outside it). A mesh open along one plane (a box without its
+  // bottom) counts as closed by that plane, and a segment must leave it before tMax. A flat
+  // convex mesh of one face is asked crossesAll.
+  int solidMeetsAll(int shape, const Vec3& p, const Vec3* dirs, int n, float tMax, float margin) const;
 
  private:
   struct Face {
@@ -68,6 +75,15 @@ class PlanarFaces {
     Vec3 inward;
     float at;
   };
+  // A mesh shape's faces (a run of faces_), with their normals turned outward, and whether
+  // the mesh bounds a solid, closed or open along one plane (solidOf).
+  struct Solid {
+    uint32_t faceBegin = 0, faceEnd = 0;
+    bool solid = false, open = false;
+    Face opening{};  // open: the boundary's plane (no edges), normal outward
+  };
+  static Solid solidOf(const Mesh& m);
+  std::vector<Solid> solids_;  // per shape
   std::vector<int64_t> firstTriangle_;  // per shape: offset of its triangles in triFace_, or -1
   std::vector<int32_t> triFace_;
   std::vector<Face> faces_;

@@ -159,6 +159,65 @@ TEST(PlanarFaces, SegmentsNearClaimedOnesMeetTheFacesTriangles) {
   EXPECT_GT(checked, 2000);
 }
 
+// A box as five quads of their own corners, open at the bottom (the Cornell box's blocks),
+// and the same box closed with shared corners, both turned: whatever solidMeetsAll claims,
+// every direction in the fan's hull, from an origin moved by the margin, meets a triangle
+// before tMax, lights inside the box and points below its opening included.
+TEST(PlanarFaces, SolidsClaimOnlySegmentsTheirTrianglesStop) {
+  Mesh open;
+  const Vec3 lo(-1, 0, -0.5f), hi(1, 1.5f, 0.5f);
+  const int quads[5][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    const int b = int(open.positions.size());
+    for (int k : q) open.positions.push_back(Vec3((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z));
+    open.triangles.push_back({b, b + 1, b + 2});
+    open.triangles.push_back({b, b + 2, b + 3});
+  }
+  Mesh closed;
+  addBox(closed, lo, hi);
+  for (Mesh* m : {&open, &closed})
+    for (Vec3& v : m->positions) v = turn(v, 0.4f) + Vec3(0.2f, 0.1f, -0.3f);
+  const Vec3 centre = turn((lo + hi) * 0.5f, 0.4f) + Vec3(0.2f, 0.1f, -0.3f);
+  for (const Mesh* m : {&open, &closed}) {
+    OneMesh one(*m);
+    PlanarFaces f(one.shapes, one.meshes);
+    Rng rng(43, 5);
+    const float margin = 2e-3f;
+    int claims = 0, inside = 0, undecided = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+      const Vec3 p = centre + Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f) * 8.0f;
+      const Vec3 aim = centre + Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f) * 3.0f;
+      const float spread = 0.8f * std::pow(rng.uniform(), 3.0f) + 4 * margin;
+      Vec3 dirs[4];
+      for (Vec3& d : dirs)
+        d = normalize(aim + Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f) * spread - p);
+      // Half the fans end near their aim (often inside the box), half well past it.
+      const float tMax = length(aim - p) * (trial % 2 ? 1.0f : 2.5f);
+      const int r = f.solidMeetsAll(0, p, dirs, 4, tMax, margin);
+      undecided += r == -1;  // only from inside the box (0.6% of the trials' volume)
+      if (r != 1) continue;
+      ++claims;
+      inside += trial % 2;
+      for (int s = 0; s < 20; ++s) {
+        float w[4], sum = 0;
+        for (float& x : w) sum += x = rng.uniform();
+        Vec3 d(0.0f);
+        for (int k = 0; k < 4; ++k) d += dirs[k] * (w[k] / sum);
+        d = normalize(d);
+        const Vec3 o = p + normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f)) * margin;
+        bool hit = false;
+        for (const auto& tr : m->triangles)
+          hit = hit || meets(o, d, tMax - margin, m->positions[size_t(tr[0])], m->positions[size_t(tr[1])],
+                             m->positions[size_t(tr[2])]);
+        EXPECT_TRUE(hit) << "trial " << trial << (m == &open ? " open" : " closed");
+      }
+    }
+    EXPECT_GT(claims, 200);
+    EXPECT_GT(inside, 20);
+    EXPECT_LT(undecided, 400);
+  }
+}
+
 // A point in the face's plane, a grazing fan, one that turns away and a face beyond tMax
 // are not proven.
 TEST(PlanarFaces, PointsInThePlaneGrazingFansAndFarFacesAreNotProven) {
