@@ -34,7 +34,8 @@ constexpr double kTurnTol = 1e-9;
 PlanarFaces::Solid PlanarFaces::solidOf(const Mesh& m) {
   Solid s;
   const auto& v = m.positions;
-  if (m.triangles.empty()) return s;
+  // Only convex meshes are asked (Scene::isConvex), which are tested up to 4096 triangles.
+  if (m.triangles.empty() || m.triangles.size() > 4096) return s;
   std::vector<std::pair<std::array<float, 3>, int>> at(v.size());
   for (size_t i = 0; i < v.size(); ++i) at[i] = {{v[i].x, v[i].y, v[i].z}, int(i)};
   std::sort(at.begin(), at.end());
@@ -66,10 +67,11 @@ PlanarFaces::Solid PlanarFaces::solidOf(const Mesh& m) {
   s.solid = true;
   if (rim.empty()) return s;
   // The boundary's plane, from its corners (welded ids back to positions).
+  std::vector<char> onRim(at.size(), 0);
+  for (int r : rim) onRim[size_t(r)] = 1;
   std::vector<D3> corners;
   for (size_t i = 0; i < at.size(); ++i)
-    if (std::find(rim.begin(), rim.end(), weld[size_t(at[i].second)]) != rim.end() &&
-        (i == 0 || at[i].first != at[i - 1].first))
+    if (onRim[size_t(weld[size_t(at[i].second)])] && (i == 0 || at[i].first != at[i - 1].first))
       corners.push_back(d3(v[size_t(at[i].second)]));
   D3 n{0, 0, 0};
   double big = 0;
