@@ -13,7 +13,7 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gen_scenes import Mesh, box_mesh, num, seeded_args, write_lines  # noqa: E402
+from gen_scenes import Mesh, box_mesh, light_text, seeded_args, write_lines  # noqa: E402
 
 W, D = 10.0, 10.0      # the building's footprint
 WELL = 2.2             # half-width of the central well
@@ -81,14 +81,8 @@ def main(argv):
             p = (x, (f + 1) * STOREY - SLAB - 0.15 - abs(rng.gauss(0, 0.1)), z)
         col = (rng.uniform(0.8, 1.0), rng.uniform(0.75, 0.95), rng.uniform(0.6, 0.85))
         i = power / n
-        pos = f"position = ({num(p[0])}, {num(p[1])}, {num(p[2])});"
-        if rng.random() < 0.25:
-            c3 = ", ".join(num(v * i * 3, 7) for v in col)
-            o.append(f"spot_light {{ {pos} direction = ({num(rng.uniform(-0.3, 0.3))}, -1, "
-                     f"{num(rng.uniform(-0.3, 0.3))}); colour = ({c3}); cone_angle = 45; exponent = 6; }}")
-        else:
-            c3 = ", ".join(num(v * i, 7) for v in col)
-            o.append(f"point_light {{ {pos} colour = ({c3}); }}")
+        spot = (rng.uniform(-0.3, 0.3), rng.uniform(-0.3, 0.3), 45, 6) if rng.random() < 0.25 else None
+        o.append(light_text(p, col, i, spot))
     write_lines(out, o)
 
 

@@ -15,7 +15,7 @@ import random
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gen_scenes import box, material, num  # noqa: E402
+from gen_scenes import box, light_text, material, num  # noqa: E402
 
 TOTAL_POWER = 300.0  # summed intensity of the point lights (each channel), whatever N
 
@@ -66,14 +66,8 @@ def main(argv):
             p = (rng.uniform(-W / 2 + 0.1, W / 2 - 0.1), rng.uniform(0.3, H - 0.1), rng.uniform(-D / 2 + 0.1, D / 2 - 0.1))
         col = rgb(0.5, 1.0)
         i = TOTAL_POWER / n
-        pos = f"position = ({num(p[0])}, {num(p[1])}, {num(p[2])});"
-        if rng.random() < spot_share:
-            c3 = ", ".join(num(v * i * 3, 7) for v in col)
-            L.append(f"spot_light {{ {pos} direction = ({num(rng.uniform(-0.5, 0.5))}, -1, "
-                     f"{num(rng.uniform(-0.5, 0.5))}); colour = ({c3}); cone_angle = 50; exponent = 4; }}\n")
-        else:
-            c3 = ", ".join(num(v * i, 7) for v in col)
-            L.append(f"point_light {{ {pos} colour = ({c3}); }}\n")
+        spot = (rng.uniform(-0.5, 0.5), rng.uniform(-0.5, 0.5), 50, 4) if rng.random() < spot_share else None
+        L.append(light_text(p, col, i, spot) + "\n")
     tmp = out + ".tmp"
     with open(tmp, "w") as f:
         f.write("".join(L))

@@ -175,6 +175,18 @@ def write_lines(path, lines):
         f.write("\n".join(lines) + "\n")
 
 
+def light_text(p, col, power, spot=None):
+    """A point light at p of colour col times power, or with spot = (dx, dz, cone_angle,
+    exponent) a spot light aimed at (dx, -1, dz), of three times that colour."""
+    pos = f"position = ({num(p[0])}, {num(p[1])}, {num(p[2])});"
+    if spot:
+        c3 = ", ".join(num(v * power * 3, 7) for v in col)
+        return (f"spot_light {{ {pos} direction = ({num(spot[0])}, -1, {num(spot[1])}); colour = ({c3}); "
+                f"cone_angle = {spot[2]}; exponent = {spot[3]}; }}")
+    c3 = ", ".join(num(v * power, 7) for v in col)
+    return f"point_light {{ {pos} colour = ({c3}); }}"
+
+
 def box(center, size, mat, rot_y=0.0, rot_z=0.0):
     """An axis-aligned box quadric, or one rotated about z, then about y (degrees)."""
     s = f"scale({num(size[0])}, {num(size[1])}, {num(size[2])}, box {{ material = {mat}; }})"

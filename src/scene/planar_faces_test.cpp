@@ -102,6 +102,20 @@ bool meets(const Vec3& o, const Vec3& d, float tMax, const Vec3& a, const Vec3& 
   return u >= 0 && v >= 0 && u + v <= 1 && t >= 0 && t <= tMax;
 }
 
+// A random unit direction in the hull of dirs[0, 4).
+Vec3 inHull(const Vec3* dirs, Rng& rng) {
+  float w[4], sum = 0;
+  for (float& x : w) sum += x = rng.uniform();
+  Vec3 d(0.0f);
+  for (int k = 0; k < 4; ++k) d += dirs[k] * (w[k] / sum);
+  return normalize(d);
+}
+
+// p moved by `margin` in a random direction.
+Vec3 nudged(const Vec3& p, float margin, Rng& rng) {
+  return p + normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f)) * margin;
+}
+
 // Whatever a face claims, the segments near the claimed ones meet its triangles: from
 // random points toward random small fans of directions, every direction in the fan's hull,
 // from an origin moved by up to the margin, meets a triangle of the face before tMax. The
@@ -137,12 +151,7 @@ TEST(PlanarFaces, SegmentsNearClaimedOnesMeetTheFacesTriangles) {
       if (f.crossesAll(face, p, dirs, 4, tMax, margin) != 1) continue;
       ++claims;
       for (int s = 0; s < 20; ++s) {
-        float w[4], sum = 0;
-        for (float& x : w) sum += x = rng.uniform();
-        Vec3 d(0.0f);
-        for (int k = 0; k < 4; ++k) d += dirs[k] * (w[k] / sum);
-        d = normalize(d);
-        const Vec3 o = p + normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f)) * margin;
+        const Vec3 d = inHull(dirs, rng), o = nudged(p, margin, rng);
         bool hit = false;
         for (size_t t = 0; t < m.triangles.size() && !hit; ++t) {
           if (f.faceOf(0, int(t)) != face) continue;
@@ -199,12 +208,7 @@ TEST(PlanarFaces, SolidsClaimOnlySegmentsTheirTrianglesStop) {
       ++claims;
       inside += trial % 2;
       for (int s = 0; s < 20; ++s) {
-        float w[4], sum = 0;
-        for (float& x : w) sum += x = rng.uniform();
-        Vec3 d(0.0f);
-        for (int k = 0; k < 4; ++k) d += dirs[k] * (w[k] / sum);
-        d = normalize(d);
-        const Vec3 o = p + normalize(Vec3(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f)) * margin;
+        const Vec3 d = inHull(dirs, rng), o = nudged(p, margin, rng);
         bool hit = false;
         for (const auto& tr : m->triangles)
           hit = hit || meets(o, d, tMax - margin, m->positions[size_t(tr[0])], m->positions[size_t(tr[1])],
