@@ -660,7 +660,8 @@ void addRenderCommand(CLI::App& app) {
       ->group(cuts);
   addSwitch(*c, "--visibility-probes", a->visibilityProbes,
             fmt::format("Lightcuts: before refining a cluster whose representative is hidden, test the corners of "
-                        "its box (boxes, spheres, capped cylinders and the flat faces of meshes answer without rays); "
+                        "its box (boxes, spheres, capped cylinders, squares, convex meshes and the flat faces of other "
+                        "meshes answer without rays); "
                         "when one convex object hides them all, the cluster stays in the cut as hidden (on) or not "
                         "(off, as published); "
                         "default {}", switchName(d.visibilityProbes)))

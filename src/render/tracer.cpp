@@ -117,9 +117,12 @@ int ShadowRays::blocksAll(int blocker, const Vec3* dirs, int n, float tMax) cons
   if (const int face = faceOf(blocker); face >= 0)
     return scene_.planarFaces().crossesAll(face, p_, dirs, n, tMax, margin);
   if (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)) return -1;
-  // A convex mesh: its faces' planes, moved in by the margin, clip each segment.
+  // A convex mesh: its faces' planes, moved in by the margin, clip each segment; a square
+  // is a face.
   if (scene_.shapes()[size_t(blocker)].kind == io::ShapeKind::Mesh)
     return scene_.planarFaces().solidMeetsAll(blocker, p_, dirs, n, tMax, margin);
+  if (const int face = scene_.planarFaces().squareFace(blocker); face >= 0)
+    return scene_.planarFaces().crossesAll(face, p_, dirs, n, tMax, margin);
   const scene::SolidWithMargin solid(scene_.shapes()[size_t(blocker)], margin);
   // From inside the shape (a room modelled as one box, seen from within) a segment runs
   // through it without crossing its surface: the rays decide, as before.

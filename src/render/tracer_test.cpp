@@ -219,5 +219,38 @@ trimesh { material = white;
   EXPECT_LT(st.shadowRays, sb.shadowRays / 2);
 }
 
+// A square (the quadric) turned above the floor is one flat face too: its probes need no
+// ray, and the cut still equals brute force at a zero threshold.
+TEST(ShadowRays, ASquareDecidesProbesAndTheCutStaysExact) {
+  auto scene = scene::Scene::build(io::parseRayString(R"(SBT-raytracer 1.0
+material = { name = white; diffuse = (0.5, 0.5, 0.5); }
+translate(0, -0.05, 0, scale(20, 0.1, 20, box { material = white; }))
+translate(-0.8, 1.45, 0, rotate(0, 1, 0, 0.5, rotate(1, 0, 0, 1.5707963, scale(3, 4, 1, square { material = white; }))))
+)",
+                                                      "square.ray", ""));
+  ASSERT_GE(scene->planarFaces().squareFace(1), 0);
+  using namespace lightcuts;
+  LightSet s = test_lights::cloud(3000, LightType::Omni, 29);
+  LightForest f = buildLightForest(s);
+  CutOptions o;
+  o.errorRatio = 0;
+  o.maxCut = 1 << 20;
+  o.visibilityProbes = true;
+  auto lcut = makeLightcuts(s, f, o);
+  auto bf = makeBruteForce(s);
+  EvalStats st, sb;
+  scene::Hit h;
+  for (int i = 0; i < 6; ++i) {
+    ASSERT_TRUE(scene->intersect(scene::Ray{Vec3(0.4f * float(i) - 2.2f, 1, 0.2f * float(i) - 0.4f), Vec3(0, -1, 0)}, h));
+    ShadowRays v(*scene, h);
+    ShadingPoint sp = test_lights::point(h.p);
+    const Color want = bf->evaluate(sp, v, sb).radiance;
+    const Color got = lcut->evaluate(sp, v, st).radiance;
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], 1e-5f * (want[k] + 1e-6f)) << i;
+  }
+  EXPECT_GT(st.hiddenClusters, 0u);
+  EXPECT_EQ(st.probeRays, 0u);
+}
+
 }  // namespace
 }  // namespace lc::render

@@ -6,11 +6,10 @@
 
 namespace lc::scene {
 
+using detail::D3;
+
 namespace {
 
-struct D3 {
-  double x, y, z;
-};
 D3 d3(const Vec3& v) { return {v.x, v.y, v.z}; }
 D3 sub(const D3& a, const D3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 D3 crossd(const D3& a, const D3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
@@ -112,13 +111,14 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
   size_t total = 0;
   for (const Shape& s : shapes)
     if (s.kind == io::ShapeKind::Mesh) total += meshes[size_t(s.mesh)].triangles.size();
-  if (total > kMaxTriangles) return;
-  triFace_.reserve(total);
+  const bool meshFaces = total <= kMaxTriangles;
+  if (meshFaces) triFace_.reserve(total);
   std::vector<std::pair<uint64_t, uint32_t>> edgeTris;  // (vertex pair, triangle), sorted
   std::vector<uint32_t> stack, members;
   std::vector<int> poly;
+  std::vector<D3> corners;
   for (size_t si = 0; si < shapes.size(); ++si) {
-    if (shapes[si].kind != io::ShapeKind::Mesh) continue;
+    if (shapes[si].kind != io::ShapeKind::Mesh || !meshFaces) continue;
     const Mesh& m = meshes[size_t(shapes[si].mesh)];
     const auto& tri = m.triangles;
     const auto& v = m.positions;
@@ -206,29 +206,12 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
         else
           ++q;
       }
-      Face f;
-      f.normal = Vec3(float(n.x), float(n.y), float(n.z));
-      f.offset = float(off);
-      double thick = 0, big = 0;
+      double thick = 0;
       for (uint32_t t : members)
-        for (int k = 0; k < 3; ++k) {
-          const Vec3& x = v[size_t(tri[t][k])];
-          f.box.extend(x);
-          thick = std::max(thick, std::fabs(dotd(n, d3(x)) - off));
-          big = std::max({big, double(std::fabs(x.x)), double(std::fabs(x.y)), double(std::fabs(x.z))});
-        }
-      // The float plane and edges round at about 1e-7 of the coordinates: counted in.
-      f.thickness = float(thick + 1e-6 * big);
-      f.edgeBegin = uint32_t(edges_.size());
-      f.edgeCount = uint32_t(poly.size());
-      for (size_t q = 0; q < poly.size(); ++q) {
-        const D3 p = d3(v[size_t(poly[q])]), qv = d3(v[size_t(poly[(q + 1) % poly.size()])]);
-        D3 in = crossd(n, sub(qv, p));
-        const double il = lend(in);
-        in = {in.x / il, in.y / il, in.z / il};
-        edges_.push_back({Vec3(float(in.x), float(in.y), float(in.z)), float(dotd(in, p))});
-      }
-      faces_.push_back(f);
+        for (int k = 0; k < 3; ++k) thick = std::max(thick, std::fabs(dotd(n, d3(v[size_t(tri[t][k])])) - off));
+      corners.clear();
+      for (int q : poly) corners.push_back(d3(v[size_t(q)]));
+      addFace(corners, n, off, thick);
     }
     // Each face's normal turned outward: away from the corners' mean, which a closed convex
     // mesh holds inside.
@@ -251,6 +234,46 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
     solids_.resize(shapes.size());
     solids_[si] = solid;
   }
+  // Squares: one face each, the unit square z = 0, |x|, |y| <= 1/2, in the world.
+  squareFace_.assign(shapes.size(), -1);
+  for (size_t si = 0; si < shapes.size(); ++si) {
+    if (shapes[si].kind != io::ShapeKind::Square) continue;
+    corners.clear();
+    for (const Vec3 c : {Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, -0.5f, 0), Vec3(0.5f, 0.5f, 0), Vec3(-0.5f, 0.5f, 0)})
+      corners.push_back(d3(shapes[si].toWorld.point(c)));
+    D3 n = crossd(sub(corners[1], corners[0]), sub(corners[2], corners[0]));
+    const double len = lend(n);
+    if (!(len > 0) || !std::isfinite(len)) continue;
+    n = {n.x / len, n.y / len, n.z / len};
+    squareFace_[si] = int(faces_.size());
+    addFace(corners, n, dotd(n, corners[0]), 0);
+  }
+}
+
+// A face from its corners, counter-clockwise about the unit normal n, on the plane
+// dot(n, x) = off, its corners up to `thick` off it.
+void PlanarFaces::addFace(const std::vector<D3>& corners, const D3& n, double off, double thick) {
+  Face f;
+  f.normal = Vec3(float(n.x), float(n.y), float(n.z));
+  f.offset = float(off);
+  double big = 0;
+  for (const D3& x : corners) {
+    f.box.extend(Vec3(float(x.x), float(x.y), float(x.z)));
+    thick = std::max(thick, std::fabs(dotd(n, x) - off));
+    big = std::max({big, std::fabs(x.x), std::fabs(x.y), std::fabs(x.z)});
+  }
+  // The float plane and edges round at about 1e-7 of the coordinates: counted in.
+  f.thickness = float(thick + 1e-6 * big);
+  f.edgeBegin = uint32_t(edges_.size());
+  f.edgeCount = uint32_t(corners.size());
+  for (size_t q = 0; q < corners.size(); ++q) {
+    const D3 &p = corners[q], &qv = corners[(q + 1) % corners.size()];
+    D3 in = crossd(n, sub(qv, p));
+    const double il = lend(in);
+    in = {in.x / il, in.y / il, in.z / il};
+    edges_.push_back({Vec3(float(in.x), float(in.y), float(in.z)), float(dotd(in, p))});
+  }
+  faces_.push_back(f);
 }
 
 int PlanarFaces::crossesAll(int face, const Vec3& p, const Vec3* dirs, int n, float tMax, float margin) const {

@@ -1,4 +1,4 @@
-// Meshes as flat convex faces, for proving light clusters hidden without rays.
+// Meshes (and squares) as flat convex faces, for proving light clusters hidden without rays.
 //
 // Lightcuts' visibility probes (evaluator.cpp, "Hidden clusters") prove a cluster hidden
 // when one convex object stops every shadow ray toward its box. Quadrics and whole convex
@@ -23,10 +23,16 @@
 
 namespace lc::scene {
 
+namespace detail {
+struct D3 {  // a point or vector in double, for building faces
+  double x, y, z;
+};
+}  // namespace detail
+
 class PlanarFaces {
  public:
-  // Scenes whose meshes hold more triangles than this in all get no faces (4 bytes per
-  // triangle and about 100 per face, up to ~55 MB here): the probes use rays as before.
+  // Scenes whose meshes hold more triangles than this in all get no mesh faces (4 bytes
+  // per triangle and about 100 per face, up to ~55 MB here): their probes use rays as before.
   static constexpr size_t kMaxTriangles = size_t(1) << 19;
   // A face stops growing at this many corners (a fan of many thin triangles).
   static constexpr int kMaxCorners = 24;
@@ -61,6 +67,8 @@ class PlanarFaces {
   // bottom) counts as closed by that plane, and a segment must leave it before tMax. A flat
   // convex mesh of one face is asked crossesAll.
   int solidMeetsAll(int shape, const Vec3& p, const Vec3* dirs, int n, float tMax, float margin) const;
+  // The face of a square shape (every square is one), or -1.
+  int squareFace(int shape) const { return size_t(shape) < squareFace_.size() ? squareFace_[size_t(shape)] : -1; }
 
  private:
   struct Face {
@@ -83,7 +91,9 @@ class PlanarFaces {
     Face opening{};  // open: the boundary's plane (no edges), normal outward
   };
   static Solid solidOf(const Mesh& m);
+  void addFace(const std::vector<detail::D3>& corners, const detail::D3& n, double off, double thick);
   std::vector<Solid> solids_;  // per shape
+  std::vector<int> squareFace_;  // per shape: a square's face, else -1
   std::vector<int64_t> firstTriangle_;  // per shape: offset of its triangles in triFace_, or -1
   std::vector<int32_t> triFace_;
   std::vector<Face> faces_;
