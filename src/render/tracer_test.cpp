@@ -159,6 +159,36 @@ translate(0, 1, -3, scale(2, 2, 0.2, box { material = white; }))
   EXPECT_EQ(vis.blocksAll(1, dirs, 8, dMin), 0);
 }
 
+// Lightcuts at a zero threshold against brute force, both with the scene's shadow rays,
+// at six points of its floor under a cloud of 3,000 lights (2 to 3 units up): at a zero
+// threshold every cluster not proven hidden is refined to its lights, so the cut must equal
+// brute force, however many clusters the probes prove hidden.
+struct ExactCuts {
+  lightcuts::EvalStats cut, brute;
+};
+ExactCuts exactCutsOnTheFloor(const scene::Scene& scene, uint64_t seed) {
+  using namespace lightcuts;
+  LightSet s = test_lights::cloud(3000, LightType::Omni, seed);
+  LightForest f = buildLightForest(s);
+  CutOptions o;
+  o.errorRatio = 0;
+  o.maxCut = 1 << 20;
+  o.visibilityProbes = true;
+  auto lcut = makeLightcuts(s, f, o);
+  auto bf = makeBruteForce(s);
+  ExactCuts e;
+  scene::Hit h;
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_TRUE(scene.intersect(scene::Ray{Vec3(0.4f * float(i) - 2.2f, 1, 0.2f * float(i) - 0.4f), Vec3(0, -1, 0)}, h));
+    ShadowRays v(scene, h);
+    ShadingPoint sp = test_lights::point(h.p);
+    const Color want = bf->evaluate(sp, v, e.brute).radiance;
+    const Color got = lcut->evaluate(sp, v, e.cut).radiance;
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], 1e-5f * (want[k] + 1e-6f)) << i;
+  }
+  return e;
+}
+
 // A canopy (a slab with a slanted edge) and a wall written as one triangle mesh (not convex as a whole): a shadow ray
 // stopped by it names the flat face it met (scene::PlanarFaces), whose bounds hold the hit,
 // and that face decides the probes without rays. With a zero threshold every cluster not
@@ -196,27 +226,10 @@ trimesh { material = white;
     EXPECT_LE(q[a], hi[a]);
   }
 
-  using namespace lightcuts;
-  LightSet s = test_lights::cloud(3000, LightType::Omni, 27);
-  LightForest f = buildLightForest(s);
-  CutOptions o;
-  o.errorRatio = 0;
-  o.maxCut = 1 << 20;
-  o.visibilityProbes = true;
-  auto lcut = makeLightcuts(s, f, o);
-  auto bf = makeBruteForce(s);
-  EvalStats st, sb;
-  for (int i = 0; i < 6; ++i) {
-    ASSERT_TRUE(scene->intersect(scene::Ray{Vec3(0.4f * float(i) - 2.2f, 1, 0.2f * float(i) - 0.4f), Vec3(0, -1, 0)}, h));
-    ShadowRays v(*scene, h);
-    ShadingPoint sp = test_lights::point(h.p);
-    const Color want = bf->evaluate(sp, v, sb).radiance;
-    const Color got = lcut->evaluate(sp, v, st).radiance;
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], 1e-5f * (want[k] + 1e-6f)) << i;
-  }
-  EXPECT_GT(st.hiddenClusters, 0u);
-  EXPECT_EQ(st.probeRays, 0u);
-  EXPECT_LT(st.shadowRays, sb.shadowRays / 2);
+  const ExactCuts e = exactCutsOnTheFloor(*scene, 27);
+  EXPECT_GT(e.cut.hiddenClusters, 0u);
+  EXPECT_EQ(e.cut.probeRays, 0u);
+  EXPECT_LT(e.cut.shadowRays, e.brute.shadowRays / 2);
 }
 
 // A square (the quadric) turned above the floor is one flat face too: its probes need no
@@ -229,27 +242,9 @@ translate(-0.8, 1.45, 0, rotate(0, 1, 0, 0.5, rotate(1, 0, 0, 1.5707963, scale(3
 )",
                                                       "square.ray", ""));
   ASSERT_GE(scene->planarFaces().squareFace(1), 0);
-  using namespace lightcuts;
-  LightSet s = test_lights::cloud(3000, LightType::Omni, 29);
-  LightForest f = buildLightForest(s);
-  CutOptions o;
-  o.errorRatio = 0;
-  o.maxCut = 1 << 20;
-  o.visibilityProbes = true;
-  auto lcut = makeLightcuts(s, f, o);
-  auto bf = makeBruteForce(s);
-  EvalStats st, sb;
-  scene::Hit h;
-  for (int i = 0; i < 6; ++i) {
-    ASSERT_TRUE(scene->intersect(scene::Ray{Vec3(0.4f * float(i) - 2.2f, 1, 0.2f * float(i) - 0.4f), Vec3(0, -1, 0)}, h));
-    ShadowRays v(*scene, h);
-    ShadingPoint sp = test_lights::point(h.p);
-    const Color want = bf->evaluate(sp, v, sb).radiance;
-    const Color got = lcut->evaluate(sp, v, st).radiance;
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(got[k], want[k], 1e-5f * (want[k] + 1e-6f)) << i;
-  }
-  EXPECT_GT(st.hiddenClusters, 0u);
-  EXPECT_EQ(st.probeRays, 0u);
+  const ExactCuts e = exactCutsOnTheFloor(*scene, 29);
+  EXPECT_GT(e.cut.hiddenClusters, 0u);
+  EXPECT_EQ(e.cut.probeRays, 0u);
 }
 
 }  // namespace
