@@ -106,6 +106,139 @@ PlanarFaces::Solid PlanarFaces::solidOf(const Mesh& m) {
   return s;
 }
 
+// Whole coplanar regions that are convex become one face each, before the greedy growth
+// (which cannot grow a grid of squares past a strip: every triangle added to a rectangle's
+// side makes a notch). A region, coplanar triangles joined across shared edges, is one face
+// when its triangles cover its convex hull exactly: every edge is shared by at most two of
+// them (no overlaps), every edge of one lies on the hull's outline (no holes), and their
+// areas add up to the hull's.
+void PlanarFaces::convexRegions(const Mesh& m, const std::vector<std::pair<uint64_t, uint32_t>>& edgeTris,
+                                size_t base) {
+  const auto& tri = m.triangles;
+  const auto& v = m.positions;
+  auto key = [](int a, int b) { return uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b)); };
+  std::vector<char> seen(tri.size(), 0);
+  std::vector<uint32_t> region, stack;
+  std::vector<uint64_t> keys;
+  std::vector<int> verts;
+  struct P2 {
+    double u, v;
+    int index;
+  };
+  std::vector<P2> pts, hull;
+  for (uint32_t seed = 0; seed < tri.size(); ++seed) {
+    if (seen[seed] || triFace_[base + seed] >= 0) continue;
+    const D3 a = d3(v[size_t(tri[seed][0])]);
+    D3 n = crossd(sub(d3(v[size_t(tri[seed][1])]), a), sub(d3(v[size_t(tri[seed][2])]), a));
+    const double len = lend(n);
+    seen[seed] = 1;
+    if (!(len > 0) || !std::isfinite(len)) continue;
+    n = {n.x / len, n.y / len, n.z / len};
+    const double off = dotd(n, a);
+    const double big = std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)});
+    region.assign({seed});
+    stack.assign({seed});
+    double extent = 0;
+    while (!stack.empty()) {
+      const uint32_t t = stack.back();
+      stack.pop_back();
+      for (int k = 0; k < 3; ++k) {
+        const uint64_t e = key(tri[t][k], tri[t][(k + 1) % 3]);
+        auto it = std::lower_bound(edgeTris.begin(), edgeTris.end(), std::make_pair(e, 0u));
+        for (; it != edgeTris.end() && it->first == e; ++it) {
+          const uint32_t u = it->second;
+          if (seen[u] || triFace_[base + u] >= 0) continue;
+          const D3 ua = d3(v[size_t(tri[u][0])]), ub = d3(v[size_t(tri[u][1])]), uc = d3(v[size_t(tri[u][2])]);
+          const D3 un = crossd(sub(ub, ua), sub(uc, ua));
+          const double ul = lend(un);
+          extent = std::max({extent, lend(sub(ub, ua)), lend(sub(uc, ua))});
+          const double tol = kPlaneTol * (extent + big);
+          if (!(ul > 0) || std::fabs(dotd(un, n)) / ul < 1 - kNormalTol || std::fabs(dotd(n, ua) - off) > tol ||
+              std::fabs(dotd(n, ub) - off) > tol || std::fabs(dotd(n, uc) - off) > tol)
+            continue;
+          seen[u] = 1;
+          region.push_back(u);
+          stack.push_back(u);
+        }
+      }
+    }
+    if (region.size() < 3) continue;  // one or two triangles: the growth does as well
+    // Edges: interior ones shared by two, outline ones by one, none by more.
+    keys.clear();
+    for (uint32_t t : region)
+      for (int k = 0; k < 3; ++k) keys.push_back(key(tri[t][k], tri[t][(k + 1) % 3]));
+    std::sort(keys.begin(), keys.end());
+    // The hull, in the plane's coordinates (u along an edge, w = n x u).
+    D3 bu = sub(d3(v[size_t(tri[seed][1])]), a);
+    bu = {bu.x / lend(bu), bu.y / lend(bu), bu.z / lend(bu)};
+    const D3 bw = crossd(n, bu);
+    verts.clear();
+    for (uint32_t t : region)
+      for (int k = 0; k < 3; ++k) verts.push_back(tri[t][k]);
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    pts.clear();
+    for (int i : verts) {
+      const D3 x = sub(d3(v[size_t(i)]), a);
+      pts.push_back({dotd(x, bu), dotd(x, bw), i});
+    }
+    std::sort(pts.begin(), pts.end(), [](const P2& p, const P2& q) { return p.u < q.u || (p.u == q.u && p.v < q.v); });
+    auto turn = [](const P2& o, const P2& p, const P2& q) { return (p.u - o.u) * (q.v - o.v) - (p.v - o.v) * (q.u - o.u); };
+    hull.assign(2 * pts.size(), P2{});
+    size_t h = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {  // Andrew's monotone chain, counter-clockwise
+      while (h >= 2 && turn(hull[h - 2], hull[h - 1], pts[i]) <= 0) --h;
+      hull[h++] = pts[i];
+    }
+    for (size_t i = pts.size() - 1, lower = h + 1; i-- > 0;) {
+      while (h >= lower && turn(hull[h - 2], hull[h - 1], pts[i]) <= 0) --h;
+      hull[h++] = pts[i];
+    }
+    hull.resize(h > 0 ? h - 1 : 0);
+    if (hull.size() < 3 || int(hull.size()) > kMaxCorners) continue;
+    double hullArea = 0, area = 0;
+    for (size_t i = 0; i < hull.size(); ++i) {
+      const P2 &p = hull[i], &q = hull[(i + 1) % hull.size()];
+      hullArea += p.u * q.v - q.u * p.v;
+    }
+    hullArea *= 0.5;
+    for (uint32_t t : region) area += 0.5 * lend(crossd(sub(d3(v[size_t(tri[t][1])]), d3(v[size_t(tri[t][0])])),
+                                                          sub(d3(v[size_t(tri[t][2])]), d3(v[size_t(tri[t][0])]))));
+    if (!(std::fabs(area - hullArea) <= 1e-7 * hullArea)) continue;
+    // Every outline edge on the hull's outline: its midpoint within tol of a hull edge.
+    const double tol = kPlaneTol * (extent + big);
+    bool covered = true;
+    for (size_t k = 0; k < keys.size() && covered;) {
+      size_t e = k;
+      while (e < keys.size() && keys[e] == keys[k]) ++e;
+      if (e - k > 2) covered = false;
+      if (e - k == 1) {
+        const D3 mid = sub({0.5 * (double(v[size_t(keys[k] >> 32)].x) + v[size_t(keys[k] & 0xffffffffu)].x),
+                            0.5 * (double(v[size_t(keys[k] >> 32)].y) + v[size_t(keys[k] & 0xffffffffu)].y),
+                            0.5 * (double(v[size_t(keys[k] >> 32)].z) + v[size_t(keys[k] & 0xffffffffu)].z)},
+                           a);
+        const P2 mp{dotd(mid, bu), dotd(mid, bw), -1};
+        bool onHull = false;
+        for (size_t i = 0; i < hull.size() && !onHull; ++i) {
+          const P2 &p = hull[i], &q = hull[(i + 1) % hull.size()];
+          const double el = std::hypot(q.u - p.u, q.v - p.v);
+          onHull = el > 0 && std::fabs(turn(p, q, mp)) / el <= tol;
+        }
+        covered = onHull;
+      }
+      k = e;
+    }
+    if (!covered) continue;
+    std::vector<D3> corners;
+    for (const P2& p : hull) corners.push_back(d3(v[size_t(p.index)]));
+    double thick = 0;
+    for (int i : verts) thick = std::max(thick, std::fabs(dotd(n, d3(v[size_t(i)])) - off));
+    const int face = int(faces_.size());
+    for (uint32_t t : region) triFace_[base + t] = face;
+    addFace(corners, n, off, thick);
+  }
+}
+
 PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mesh>& meshes) {
   firstTriangle_.assign(shapes.size(), -1);
   size_t total = 0;
@@ -140,6 +273,7 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
           if (it->second != t && triFace_[base + it->second] < 0) stack.push_back(it->second);
       }
     };
+    convexRegions(m, edgeTris, base);
     for (uint32_t seed = 0; seed < tri.size(); ++seed) {
       if (triFace_[base + seed] >= 0) continue;
       const D3 a = d3(v[size_t(tri[seed][0])]), b = d3(v[size_t(tri[seed][1])]), c = d3(v[size_t(tri[seed][2])]);

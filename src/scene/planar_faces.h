@@ -9,9 +9,10 @@
 // stopped by a triangle names the face that triangle belongs to, and the probe asks
 // whether every corner's segment crosses that face, well inside its edges.
 //
-// Faces are grown greedily from each triangle across edges it shares (by vertex index)
-// with coplanar triangles, while the polygon stays convex; a triangle no neighbour joins
-// is a face of its own. The polygon is exactly the union of its triangles: a triangle
+// A region of coplanar triangles joined across shared edges that covers its convex hull
+// exactly is one face (convexRegions). Other faces are grown greedily from each triangle
+// across edges it shares (by vertex index) with coplanar triangles, while the polygon
+// stays convex; a triangle no neighbour joins is a face of its own. The polygon is exactly the union of its triangles: a triangle
 // joins across an edge of the polygon's boundary, from outside it, so none overlap.
 #pragma once
 
@@ -92,6 +93,7 @@ class PlanarFaces {
   };
   static Solid solidOf(const Mesh& m);
   void addFace(const std::vector<detail::D3>& corners, const detail::D3& n, double off, double thick);
+  void convexRegions(const Mesh& m, const std::vector<std::pair<uint64_t, uint32_t>>& edgeTris, size_t base);
   std::vector<Solid> solids_;  // per shape
   std::vector<int> squareFace_;  // per shape: a square's face, else -1
   std::vector<int64_t> firstTriangle_;  // per shape: offset of its triangles in triFace_, or -1

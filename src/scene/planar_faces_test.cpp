@@ -56,6 +56,54 @@ TEST(PlanarFaces, ABoxMeshIsSixQuadrilaterals) {
   EXPECT_EQ(f.faceOf(1, 0), -1);  // no such shape
 }
 
+// A grid of 20 x 20 squares, as a floor is often written, is one rectangle: corners on its
+// straight edges do not count against the face's corner limit.
+TEST(PlanarFaces, AGridIsOneRectangle) {
+  Mesh m;
+  const int n = 20;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) m.positions.push_back(Vec3(float(i), 0, float(j)));
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int a = i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
+      m.triangles.push_back({a, b, d});
+      m.triangles.push_back({a, d, c});
+    }
+  OneMesh one(m);
+  PlanarFaces f(one.shapes, one.meshes);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_EQ(f.corners(0), 4);
+  for (int t = 0; t < 2 * n * n; ++t) EXPECT_EQ(f.faceOf(0, t), 0) << t;
+}
+
+// The same grid with its middle square left out: its hole is never claimed, and the ring
+// around it is still covered.
+TEST(PlanarFaces, AGridWithAHoleNeverClaimsTheHole) {
+  Mesh m;
+  const int n = 5;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) m.positions.push_back(Vec3(float(i), 0, float(j)));
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      if (i == 2 && j == 2) continue;
+      const int a = i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
+      m.triangles.push_back({a, b, d});
+      m.triangles.push_back({a, d, c});
+    }
+  OneMesh one(m);
+  PlanarFaces f(one.shapes, one.meshes);
+  ASSERT_GT(f.size(), 1u);
+  const Vec3 p(2.5f, -2, 2.5f);
+  Vec3 hole[1] = {normalize(Vec3(2.5f, 1, 2.5f) - p)};
+  Vec3 ring[1] = {normalize(Vec3(0.5f, 1, 4.5f) - p)};
+  int claims = 0;
+  for (int face = 0; face < int(f.size()); ++face) {
+    EXPECT_EQ(f.crossesAll(face, p, hole, 1, 10, 1e-4f), 0) << face;
+    claims += f.crossesAll(face, p, ring, 1, 10, 1e-4f) == 1;
+  }
+  EXPECT_EQ(claims, 1);
+}
+
 // An L of three unit squares in one plane: not convex, so no face may hold all of it, and
 // no segment through the missing square may be claimed.
 TEST(PlanarFaces, AnLShapeSplitsAndItsNotchIsNeverClaimed) {
