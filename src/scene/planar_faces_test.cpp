@@ -56,20 +56,27 @@ TEST(PlanarFaces, ABoxMeshIsSixQuadrilaterals) {
   EXPECT_EQ(f.faceOf(1, 0), -1);  // no such shape
 }
 
-// A grid of 20 x 20 squares, as a floor is often written, is one rectangle: corners on its
-// straight edges do not count against the face's corner limit.
-TEST(PlanarFaces, AGridIsOneRectangle) {
+// An n x n grid of unit squares in the plane y = 0, two triangles each, without the square
+// at (hole, hole) when hole >= 0.
+Mesh grid(int n, int hole = -1) {
   Mesh m;
-  const int n = 20;
   for (int i = 0; i <= n; ++i)
     for (int j = 0; j <= n; ++j) m.positions.push_back(Vec3(float(i), 0, float(j)));
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
+      if (i == hole && j == hole) continue;
       const int a = i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
       m.triangles.push_back({a, b, d});
       m.triangles.push_back({a, d, c});
     }
-  OneMesh one(m);
+  return m;
+}
+
+// A grid of 20 x 20 squares, as a floor is often written, is one rectangle: corners on its
+// straight edges do not count against the face's corner limit.
+TEST(PlanarFaces, AGridIsOneRectangle) {
+  const int n = 20;
+  OneMesh one(grid(n));
   PlanarFaces f(one.shapes, one.meshes);
   ASSERT_EQ(f.size(), 1u);
   EXPECT_EQ(f.corners(0), 4);
@@ -79,18 +86,7 @@ TEST(PlanarFaces, AGridIsOneRectangle) {
 // The same grid with its middle square left out: its hole is never claimed, and the ring
 // around it is still covered.
 TEST(PlanarFaces, AGridWithAHoleNeverClaimsTheHole) {
-  Mesh m;
-  const int n = 5;
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) m.positions.push_back(Vec3(float(i), 0, float(j)));
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      if (i == 2 && j == 2) continue;
-      const int a = i * (n + 1) + j, b = a + 1, c = a + n + 1, d = c + 1;
-      m.triangles.push_back({a, b, d});
-      m.triangles.push_back({a, d, c});
-    }
-  OneMesh one(m);
+  OneMesh one(grid(5, 2));
   PlanarFaces f(one.shapes, one.meshes);
   ASSERT_GT(f.size(), 1u);
   const Vec3 p(2.5f, -2, 2.5f);
