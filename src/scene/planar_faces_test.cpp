@@ -56,6 +56,18 @@ TEST(PlanarFaces, ABoxMeshIsSixQuadrilaterals) {
   EXPECT_EQ(f.faceOf(1, 0), -1);  // no such shape
 }
 
+// From p, no face may claim the segment toward `gap` (through a hole in the mesh), and
+// exactly one must claim the one toward `cover` (through the mesh).
+void expectGapAndCover(const PlanarFaces& f, const Vec3& p, const Vec3& gap, const Vec3& cover) {
+  Vec3 through[1] = {normalize(gap - p)}, onto[1] = {normalize(cover - p)};
+  int claims = 0;
+  for (int face = 0; face < int(f.size()); ++face) {
+    EXPECT_EQ(f.crossesAll(face, p, through, 1, 10, 1e-4f), 0) << face;
+    claims += f.crossesAll(face, p, onto, 1, 10, 1e-4f) == 1;
+  }
+  EXPECT_EQ(claims, 1);
+}
+
 // An n x n grid of unit squares in the plane y = 0, two triangles each, without the square
 // at (hole, hole) when hole >= 0.
 Mesh grid(int n, int hole = -1) {
@@ -89,15 +101,7 @@ TEST(PlanarFaces, AGridWithAHoleNeverClaimsTheHole) {
   OneMesh one(grid(5, 2));
   PlanarFaces f(one.shapes, one.meshes);
   ASSERT_GT(f.size(), 1u);
-  const Vec3 p(2.5f, -2, 2.5f);
-  Vec3 hole[1] = {normalize(Vec3(2.5f, 1, 2.5f) - p)};
-  Vec3 ring[1] = {normalize(Vec3(0.5f, 1, 4.5f) - p)};
-  int claims = 0;
-  for (int face = 0; face < int(f.size()); ++face) {
-    EXPECT_EQ(f.crossesAll(face, p, hole, 1, 10, 1e-4f), 0) << face;
-    claims += f.crossesAll(face, p, ring, 1, 10, 1e-4f) == 1;
-  }
-  EXPECT_EQ(claims, 1);
+  expectGapAndCover(f, Vec3(2.5f, -2, 2.5f), Vec3(2.5f, 1, 2.5f), Vec3(0.5f, 1, 4.5f));
 }
 
 // An L of three unit squares in one plane: not convex, so no face may hold all of it, and
@@ -116,15 +120,7 @@ TEST(PlanarFaces, AnLShapeSplitsAndItsNotchIsNeverClaimed) {
   EXPECT_EQ(faces.count(-1), 0u);
   // From below the plane, toward points above it: through the notch (1..2, 1..2), never;
   // through the middle of the first square, some face must claim it.
-  const Vec3 p(0.5f, 0.5f, -1);
-  Vec3 notch[1] = {normalize(Vec3(1.5f, 1.5f, 0) - p)};
-  Vec3 inside[1] = {normalize(Vec3(0.5f, 0.5f, 1) - p)};
-  int claims = 0;
-  for (int face = 0; face < int(f.size()); ++face) {
-    EXPECT_EQ(f.crossesAll(face, p, notch, 1, 10, 1e-4f), 0) << face;
-    claims += f.crossesAll(face, p, inside, 1, 10, 1e-4f) == 1;
-  }
-  EXPECT_EQ(claims, 1);
+  expectGapAndCover(f, Vec3(0.5f, 0.5f, -1), Vec3(1.5f, 1.5f, 0), Vec3(0.5f, 0.5f, 1));
 }
 
 // Whether the segment o + d t, t in [0, tMax], meets triangle (a, b, c), in double.
