@@ -653,7 +653,8 @@ class Lightcuts final : public LightEvaluator {
           ++stats.probesRuledOut;
           return false;
         }
-    // A box or a sphere is asked directly whether it stops every corner's segment: no rays.
+    // A blocker whose shape is known (a box, sphere, capped cylinder, square, convex mesh or
+    // a mesh's flat face) is asked directly whether it stops every corner's segment: no rays.
     switch (vis.blocksAll(rep.blocker, dirs, m, dMin)) {
       case 0: ++stats.probesRuledOut; return false;
       case 1: return true;

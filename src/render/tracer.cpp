@@ -89,8 +89,7 @@ bool ShadowRays::boxClear(const Vec3& lo, const Vec3& hi, uint32_t& hint) {
 // own float rounding.
 bool ShadowRays::blockerBox(int blocker, Vec3& lo, Vec3& hi) const {
   const int face = faceOf(blocker);
-  if (face < 0 && (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)))
-    return false;
+  if (face < 0 && !convexShape(blocker)) return false;
   const Bounds3& b = face >= 0 ? scene_.planarFaces().bounds(face) : scene_.convexBounds(blocker);
   if (b.empty()) return false;
   const Vec3 big = vmax(vabs(b.lo), vabs(b.hi));
@@ -116,7 +115,7 @@ int ShadowRays::blocksAll(int blocker, const Vec3* dirs, int n, float tMax) cons
   // A mesh's flat face: every segment crosses it well inside its edges (planar_faces.h).
   if (const int face = faceOf(blocker); face >= 0)
     return scene_.planarFaces().crossesAll(face, p_, dirs, n, tMax, margin);
-  if (blocker < 0 || size_t(blocker) >= scene_.shapes().size() || !scene_.isConvex(blocker)) return -1;
+  if (!convexShape(blocker)) return -1;
   // A convex mesh: its faces' planes, moved in by the margin, clip each segment; a square
   // is a face.
   if (scene_.shapes()[size_t(blocker)].kind == io::ShapeKind::Mesh)

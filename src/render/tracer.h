@@ -42,6 +42,10 @@ class ShadowRays final : public lightcuts::Visibility {
                ? int(size_t(blocker) - shapes)
                : -1;
   }
+  // Whether a blocker number names a convex shape.
+  bool convexShape(int blocker) const {
+    return blocker >= 0 && size_t(blocker) < scene_.shapes().size() && scene_.isConvex(blocker);
+  }
 
  private:
   Vec3 origin(const Vec3& wi, float dist, float& tmax, Vec3& dir) const;

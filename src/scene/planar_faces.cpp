@@ -23,6 +23,40 @@ constexpr double kNormalTol = 1e-8;  // 1 - |cos| of the angle between the norma
 constexpr double kPlaneTol = 1e-6;
 constexpr double kTurnTol = 1e-9;
 
+// An edge by its two corners' indices, in either order.
+uint64_t edgeKey(int a, int b) { return uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b)); }
+
+// The unit normal of triangle (a, b, c), counter-clockwise; false when it has no area.
+bool unitNormal(const D3& a, const D3& b, const D3& c, D3& n) {
+  n = crossd(sub(b, a), sub(c, a));
+  const double len = lend(n);
+  if (!(len > 0) || !std::isfinite(len)) return false;
+  n = {n.x / len, n.y / len, n.z / len};
+  return true;
+}
+
+// Whether triangle (a, b, c) lies in the plane dot(n, x) = off (n unit), facing either way:
+// its normal within kNormalTol of n's, its corners within tol of the plane.
+bool inPlane(const D3& n, double off, double tol, const D3& a, const D3& b, const D3& c) {
+  const D3 un = crossd(sub(b, a), sub(c, a));
+  const double ul = lend(un);
+  return ul > 0 && std::fabs(dotd(un, n)) / ul >= 1 - kNormalTol && std::fabs(dotd(n, a) - off) <= tol &&
+         std::fabs(dotd(n, b) - off) <= tol && std::fabs(dotd(n, c) - off) <= tol;
+}
+
+// Calls f(u) for each triangle u other than t that shares an edge with t (by corner index);
+// edgeTris holds (edgeKey, triangle) for every triangle's edges, sorted.
+template <class F>
+void forEachNeighbour(const std::vector<std::pair<uint64_t, uint32_t>>& edgeTris,
+                      const std::vector<std::array<int, 3>>& tri, uint32_t t, const F& f) {
+  for (int k = 0; k < 3; ++k) {
+    const uint64_t e = edgeKey(tri[t][k], tri[t][(k + 1) % 3]);
+    for (auto it = std::lower_bound(edgeTris.begin(), edgeTris.end(), std::make_pair(e, 0u));
+         it != edgeTris.end() && it->first == e; ++it)
+      if (it->second != t) f(it->second);
+  }
+}
+
 }  // namespace
 
 // Whether a mesh bounds a solid: its corners welded by position, every edge joins two
@@ -49,7 +83,7 @@ PlanarFaces::Solid PlanarFaces::solidOf(const Mesh& m) {
     for (int k = 0; k < 3; ++k) {
       const int a = weld[size_t(t[k])], b = weld[size_t(t[(k + 1) % 3])];
       if (a == b) return s;  // a degenerate triangle
-      edges.push_back(uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b)));
+      edges.push_back(edgeKey(a, b));
     }
   std::sort(edges.begin(), edges.end());
   std::vector<int> rim;  // welded corners on the boundary
@@ -116,7 +150,6 @@ void PlanarFaces::convexRegions(const Mesh& m, const std::vector<std::pair<uint6
                                 size_t base) {
   const auto& tri = m.triangles;
   const auto& v = m.positions;
-  auto key = [](int a, int b) { return uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b)); };
   std::vector<char> seen(tri.size(), 0);
   std::vector<uint32_t> region, stack;
   std::vector<uint64_t> keys;
@@ -128,12 +161,10 @@ void PlanarFaces::convexRegions(const Mesh& m, const std::vector<std::pair<uint6
   std::vector<P2> pts, hull;
   for (uint32_t seed = 0; seed < tri.size(); ++seed) {
     if (seen[seed] || triFace_[base + seed] >= 0) continue;
-    const D3 a = d3(v[size_t(tri[seed][0])]);
-    D3 n = crossd(sub(d3(v[size_t(tri[seed][1])]), a), sub(d3(v[size_t(tri[seed][2])]), a));
-    const double len = lend(n);
     seen[seed] = 1;
-    if (!(len > 0) || !std::isfinite(len)) continue;
-    n = {n.x / len, n.y / len, n.z / len};
+    const D3 a = d3(v[size_t(tri[seed][0])]);
+    D3 n;
+    if (!unitNormal(a, d3(v[size_t(tri[seed][1])]), d3(v[size_t(tri[seed][2])]), n)) continue;
     const double off = dotd(n, a);
     const double big = std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)});
     region.assign({seed});
@@ -142,31 +173,21 @@ void PlanarFaces::convexRegions(const Mesh& m, const std::vector<std::pair<uint6
     while (!stack.empty()) {
       const uint32_t t = stack.back();
       stack.pop_back();
-      for (int k = 0; k < 3; ++k) {
-        const uint64_t e = key(tri[t][k], tri[t][(k + 1) % 3]);
-        auto it = std::lower_bound(edgeTris.begin(), edgeTris.end(), std::make_pair(e, 0u));
-        for (; it != edgeTris.end() && it->first == e; ++it) {
-          const uint32_t u = it->second;
-          if (seen[u] || triFace_[base + u] >= 0) continue;
-          const D3 ua = d3(v[size_t(tri[u][0])]), ub = d3(v[size_t(tri[u][1])]), uc = d3(v[size_t(tri[u][2])]);
-          const D3 un = crossd(sub(ub, ua), sub(uc, ua));
-          const double ul = lend(un);
-          extent = std::max({extent, lend(sub(ub, ua)), lend(sub(uc, ua))});
-          const double tol = kPlaneTol * (extent + big);
-          if (!(ul > 0) || std::fabs(dotd(un, n)) / ul < 1 - kNormalTol || std::fabs(dotd(n, ua) - off) > tol ||
-              std::fabs(dotd(n, ub) - off) > tol || std::fabs(dotd(n, uc) - off) > tol)
-            continue;
-          seen[u] = 1;
-          region.push_back(u);
-          stack.push_back(u);
-        }
-      }
+      forEachNeighbour(edgeTris, tri, t, [&](uint32_t u) {
+        if (seen[u] || triFace_[base + u] >= 0) return;
+        const D3 ua = d3(v[size_t(tri[u][0])]), ub = d3(v[size_t(tri[u][1])]), uc = d3(v[size_t(tri[u][2])]);
+        extent = std::max({extent, lend(sub(ub, ua)), lend(sub(uc, ua))});
+        if (!inPlane(n, off, kPlaneTol * (extent + big), ua, ub, uc)) return;
+        seen[u] = 1;
+        region.push_back(u);
+        stack.push_back(u);
+      });
     }
     if (region.size() < 3) continue;  // one or two triangles: the growth does as well
     // Edges: interior ones shared by two, outline ones by one, none by more.
     keys.clear();
     for (uint32_t t : region)
-      for (int k = 0; k < 3; ++k) keys.push_back(key(tri[t][k], tri[t][(k + 1) % 3]));
+      for (int k = 0; k < 3; ++k) keys.push_back(edgeKey(tri[t][k], tri[t][(k + 1) % 3]));
     std::sort(keys.begin(), keys.end());
     // The hull, in the plane's coordinates (u along an edge, w = n x u).
     D3 bu = sub(d3(v[size_t(tri[seed][1])]), a);
@@ -213,11 +234,8 @@ void PlanarFaces::convexRegions(const Mesh& m, const std::vector<std::pair<uint6
       while (e < keys.size() && keys[e] == keys[k]) ++e;
       if (e - k > 2) covered = false;
       if (e - k == 1) {
-        const D3 mid = sub({0.5 * (double(v[size_t(keys[k] >> 32)].x) + v[size_t(keys[k] & 0xffffffffu)].x),
-                            0.5 * (double(v[size_t(keys[k] >> 32)].y) + v[size_t(keys[k] & 0xffffffffu)].y),
-                            0.5 * (double(v[size_t(keys[k] >> 32)].z) + v[size_t(keys[k] & 0xffffffffu)].z)},
-                           a);
-        const P2 mp{dotd(mid, bu), dotd(mid, bw), -1};
+        const D3 e0 = sub(d3(v[size_t(keys[k] >> 32)]), a), e1 = sub(d3(v[size_t(keys[k] & 0xffffffffu)]), a);
+        const P2 mp{0.5 * (dotd(e0, bu) + dotd(e1, bu)), 0.5 * (dotd(e0, bw) + dotd(e1, bw)), -1};
         bool onHull = false;
         for (size_t i = 0; i < hull.size() && !onHull; ++i) {
           const P2 &p = hull[i], &q = hull[(i + 1) % hull.size()];
@@ -245,7 +263,10 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
   for (const Shape& s : shapes)
     if (s.kind == io::ShapeKind::Mesh) total += meshes[size_t(s.mesh)].triangles.size();
   const bool meshFaces = total <= kMaxTriangles;
-  if (meshFaces) triFace_.reserve(total);
+  if (meshFaces) {
+    triFace_.reserve(total);
+    solids_.resize(shapes.size());
+  }
   std::vector<std::pair<uint64_t, uint32_t>> edgeTris;  // (vertex pair, triangle), sorted
   std::vector<uint32_t> stack, members;
   std::vector<int> poly;
@@ -258,29 +279,23 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
     firstTriangle_[si] = int64_t(triFace_.size());
     const size_t base = triFace_.size();
     triFace_.resize(base + tri.size(), -1);
-    auto key = [](int a, int b) { return uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b)); };
     edgeTris.clear();
     for (uint32_t t = 0; t < tri.size(); ++t)
-      for (int k = 0; k < 3; ++k) edgeTris.push_back({key(tri[t][k], tri[t][(k + 1) % 3]), t});
+      for (int k = 0; k < 3; ++k) edgeTris.push_back({edgeKey(tri[t][k], tri[t][(k + 1) % 3]), t});
     std::sort(edgeTris.begin(), edgeTris.end());
     Solid solid = solidOf(m);
     solid.faceBegin = uint32_t(faces_.size());
     auto pushNeighbours = [&](uint32_t t) {
-      for (int k = 0; k < 3; ++k) {
-        const uint64_t e = key(tri[t][k], tri[t][(k + 1) % 3]);
-        auto it = std::lower_bound(edgeTris.begin(), edgeTris.end(), std::make_pair(e, 0u));
-        for (; it != edgeTris.end() && it->first == e; ++it)
-          if (it->second != t && triFace_[base + it->second] < 0) stack.push_back(it->second);
-      }
+      forEachNeighbour(edgeTris, tri, t, [&](uint32_t u) {
+        if (triFace_[base + u] < 0) stack.push_back(u);
+      });
     };
     convexRegions(m, edgeTris, base);
     for (uint32_t seed = 0; seed < tri.size(); ++seed) {
       if (triFace_[base + seed] >= 0) continue;
       const D3 a = d3(v[size_t(tri[seed][0])]), b = d3(v[size_t(tri[seed][1])]), c = d3(v[size_t(tri[seed][2])]);
-      D3 n = crossd(sub(b, a), sub(c, a));
-      const double len = lend(n);
-      if (!(len > 0) || !std::isfinite(len)) continue;  // degenerate: no face
-      n = {n.x / len, n.y / len, n.z / len};
+      D3 n;
+      if (!unitNormal(a, b, c, n)) continue;  // degenerate: no face
       const double off = dotd(n, a);
       double extent = std::max({lend(sub(b, a)), lend(sub(c, a)), lend(sub(c, b))});
       const int face = int(faces_.size());
@@ -294,12 +309,8 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
         stack.pop_back();
         if (triFace_[base + u] >= 0) continue;
         const D3 ua = d3(v[size_t(tri[u][0])]), ub = d3(v[size_t(tri[u][1])]), uc = d3(v[size_t(tri[u][2])]);
-        D3 un = crossd(sub(ub, ua), sub(uc, ua));
-        const double ul = lend(un);
-        if (!(ul > 0) || std::fabs(dotd(un, n)) / ul < 1 - kNormalTol) continue;
-        const double tol = kPlaneTol * (extent + std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)}));
-        if (std::fabs(dotd(n, ua) - off) > tol || std::fabs(dotd(n, ub) - off) > tol ||
-            std::fabs(dotd(n, uc) - off) > tol)
+        if (!inPlane(n, off, kPlaneTol * (extent + std::max({std::fabs(a.x), std::fabs(a.y), std::fabs(a.z)})), ua,
+                     ub, uc))
           continue;
         // The edge u shares with the polygon's boundary, and u's corner across it.
         bool joined = false;
@@ -347,25 +358,22 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
       for (int q : poly) corners.push_back(d3(v[size_t(q)]));
       addFace(corners, n, off, thick);
     }
-    // Each face's normal turned outward: away from the corners' mean, which a closed convex
-    // mesh holds inside.
+    // A solid's faces get their normals turned outward: away from the corners' mean, which
+    // a convex solid holds inside.
     solid.faceEnd = uint32_t(faces_.size());
-    D3 mean{0, 0, 0};
-    for (const Vec3& x : v) mean = {mean.x + x.x, mean.y + x.y, mean.z + x.z};
-    const double nv = double(std::max<size_t>(v.size(), 1));
-    mean = {mean.x / nv, mean.y / nv, mean.z / nv};
-    for (uint32_t k = solid.faceBegin; k < solid.faceEnd; ++k) {
-      Face& f = faces_[k];
-      if (dotd(d3(f.normal), mean) - f.offset > 0) {
-        f.normal = -f.normal;
-        f.offset = -f.offset;
-      }
+    if (solid.solid) {
+      D3 mean{0, 0, 0};
+      for (const Vec3& x : v) mean = {mean.x + x.x, mean.y + x.y, mean.z + x.z};
+      mean = {mean.x / double(v.size()), mean.y / double(v.size()), mean.z / double(v.size())};
+      auto outward = [&](Face& f) {
+        if (dotd(d3(f.normal), mean) - f.offset > 0) {
+          f.normal = -f.normal;
+          f.offset = -f.offset;
+        }
+      };
+      for (uint32_t k = solid.faceBegin; k < solid.faceEnd; ++k) outward(faces_[k]);
+      if (solid.open) outward(solid.opening);
     }
-    if (solid.open && dotd(d3(solid.opening.normal), mean) - solid.opening.offset > 0) {
-      solid.opening.normal = -solid.opening.normal;
-      solid.opening.offset = -solid.opening.offset;
-    }
-    solids_.resize(shapes.size());
     solids_[si] = solid;
   }
   // Squares: one face each, the unit square z = 0, |x|, |y| <= 1/2, in the world.
@@ -375,10 +383,8 @@ PlanarFaces::PlanarFaces(const std::vector<Shape>& shapes, const std::vector<Mes
     corners.clear();
     for (const Vec3 c : {Vec3(-0.5f, -0.5f, 0), Vec3(0.5f, -0.5f, 0), Vec3(0.5f, 0.5f, 0), Vec3(-0.5f, 0.5f, 0)})
       corners.push_back(d3(shapes[si].toWorld.point(c)));
-    D3 n = crossd(sub(corners[1], corners[0]), sub(corners[2], corners[0]));
-    const double len = lend(n);
-    if (!(len > 0) || !std::isfinite(len)) continue;
-    n = {n.x / len, n.y / len, n.z / len};
+    D3 n;
+    if (!unitNormal(corners[0], corners[1], corners[2], n)) continue;
     squareFace_[si] = int(faces_.size());
     addFace(corners, n, dotd(n, corners[0]), 0);
   }
