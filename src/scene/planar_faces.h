@@ -56,8 +56,10 @@ class PlanarFaces {
 
   // Whether every segment from p along dirs[0, n) (unit) crosses the face more than
   // `margin` inside its edges, between `margin` past p and `margin` before tMax, where
-  // segments that run within `margin` of these do the same: 1 yes, else 0 (not proven; so
-  // too when p lies within the margin of the face's plane). A crossing's inset grows as
+  // segments that run within `margin` of these do the same: 1 yes, -1 cannot tell (p lies
+  // within the margin of the plane and every segment crosses it within the margin of the
+  // face: the rays may well meet it), else 0 (not proven; so too when p lies within the
+  // margin of the plane beside the face). A crossing's inset grows as
   // 1/cos of the angle to the normal: a segment moved sideways by d meets a plane
   // crossed at that angle up to d / cos further along it.
   int crossesAll(int face, const Vec3& p, const Vec3* dirs, int n, float tMax, float margin) const;
@@ -92,6 +94,10 @@ class PlanarFaces {
     Face opening{};  // open: the boundary's plane (no edges), normal outward
   };
   static Solid solidOf(const Mesh& m);
+  // Whether every segment from p, which lies within mg of the face's plane (signed distance
+  // sp), crosses that plane within mg of the face (inside its edges moved out by mg): where
+  // the rays may meet it.
+  bool nearCrossingsInside(const Face& f, const Vec3& p, float sp, const Vec3* dirs, int n, float mg) const;
   void addFace(const std::vector<detail::D3>& corners, const detail::D3& n, double off, double thick);
   void convexRegions(const Mesh& m, const std::vector<std::pair<uint64_t, uint32_t>>& edgeTris, size_t base);
   std::vector<Solid> solids_;  // per shape

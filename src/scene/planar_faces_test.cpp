@@ -284,5 +284,24 @@ TEST(PlanarFaces, PointsInThePlaneGrazingFansAndFarFacesAreNotProven) {
   EXPECT_EQ(f.crossesAll(top, Vec3(0.9995f, 3, 0), edge, 1, 10, 1e-3f), 0);
 }
 
+// Where the face may well stop the rays but the margin keeps the test from proving it, the
+// rays are asked (-1): a point within the margin of the plane whose segments cross it on the
+// face (a wall just behind a window mesh). Beside the face: 0.
+TEST(PlanarFaces, PointsJustBehindAFaceAreLeftToTheRays) {
+  Mesh m;
+  addBox(m, Vec3(-1, 0, -1), Vec3(1, 1, 1));
+  OneMesh one(m);
+  PlanarFaces f(one.shapes, one.meshes);
+  const int top = f.faceOf(0, 2 * 3);  // the quad at y = 1
+  ASSERT_GE(top, 0);
+  const float margin = 1e-3f;
+  Vec3 down[2] = {normalize(Vec3(0.3f, -1, 0)), normalize(Vec3(-0.2f, -1, 0.1f))};
+  EXPECT_EQ(f.crossesAll(top, Vec3(0, 1.0005f, 0), down, 2, 10, margin), -1);     // through the face
+  EXPECT_EQ(f.crossesAll(top, Vec3(0, 0.9995f, 0), down, 2, 10, margin), 0);      // leaving the plane
+  EXPECT_EQ(f.crossesAll(top, Vec3(1.01f, 1.0005f, 0), down, 2, 10, margin), 0);  // beside the face
+  Vec3 slant[2] = {normalize(Vec3(10, -1, 0)), down[1]};
+  EXPECT_EQ(f.crossesAll(top, Vec3(0.999f, 1.0005f, 0), slant, 2, 10, margin), 0);  // one crosses beside it
+}
+
 }  // namespace
 }  // namespace lc::scene
