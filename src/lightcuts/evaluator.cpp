@@ -88,7 +88,8 @@ constexpr double kSmoothSpreadMin = 0.5;
 // times the cluster's unshadowed light squared. Two representatives disagree with
 // probability 2v(1 - v), so half the point's boundary rate (how often refining split a
 // cluster into a visible and a hidden half) stands for v(1 - v). A visible node whose
-// sibling agreed with it adds, in square, its estimate squared times that, scaled so
+// sibling agreed with it adds, in square, its estimate squared times that, and so does a
+// hidden node its unshadowed estimate (as well as its upper bound), scaled so
 // that the criterion's 1.6 (kTotalFactor) root-sum-square holds 2.576 standard deviations,
 // where 99% of a normal error lies: (1.6 x 2.576)^2 / 2 = 8.5. (It was 4, chosen on random
 // rooms; a lattice, scripts/gen_pergola.py, whose clusters are all partly hidden, kept 1.8%
@@ -155,6 +156,9 @@ struct ShadowResult {
   CutVisibility found = CutVisibility::Untested;
   int blocker = Visibility::kVisible;
   float tHit = 0;
+  // The luminance of M * G before the ray: what a hidden representative's cluster is
+  // estimated to hold, per unit intensity, if it were visible (kHiddenSharePerBoundary).
+  float unshadowed = 0;
 };
 
 // M * G * V of one light per unit intensity (one shadow ray when the rest is non-zero).
@@ -167,6 +171,7 @@ inline Color shadowedUnit(const Light& l, const LightGroup& g, const ShadingPoin
   float dist;
   res = ShadowResult{};
   if (!lightContribution(l, g, sp, mg, wi, dist)) return Color(0);
+  res.unshadowed = luminance(mg);
   if (clear) {
     res.found = CutVisibility::Visible;
     return mg;
@@ -390,9 +395,10 @@ class Lightcuts final : public LightEvaluator {
         if (freshCount < 2) fresh[freshCount++] = {t, left, right};
         const float lo = luminance(lower);
         // A hidden representative's spread stays its whole upper bound. (Counting its
-        // cluster's visible part as the other side of the visibility coin instead, from its
-        // unshadowed estimate, saved 7-11% of the rays but put a room lit through blinds,
-        // scripts/gen_blinds.py, from 1.44% to 1.68% of pixels over 2%: docs/LIGHTCUTS.md.)
+        // cluster's visible part as the other side of the visibility coin instead of that
+        // bound saved 7-11% of the rays but put a room lit through blinds,
+        // scripts/gen_blinds.py, from 1.44% to 1.68% of pixels over 2%; it is counted as
+        // well as the bound, below. docs/LIGHTCUTS.md.)
         float spread = visible && !boundary ? std::max(0.0f, b - lo) : b;
         // Where the contribution is smooth over the cluster and its representative is
         // unoccluded, the node takes the first-order estimate (estimate.h) if it is still
@@ -405,8 +411,20 @@ class Lightcuts final : public LightEvaluator {
         if (fo) __builtin_prefetch(&tree.moments[ni]);
         const bool scaled = rss && fo && !boundary;
         (scaled ? sumScaled : sumSq) += double(spread) * spread;
-        const float le = luminance(est);
-        const float hideable = rss && visible && !boundary && !clear ? le * le : 0.0f;
+        // The visibility coin, both sides: a visible representative's cluster (its sibling's
+        // was visible too) may be partly hidden, a hidden one's partly visible, and the
+        // error is that part of its unshadowed light. The hidden side is an error of one
+        // sign on each of hundreds of nodes where a fine screen splits every cluster
+        // (scripts/gen_lattice.py, gen_pergola.py): its upper bound alone, in the root-sum-
+        // square, left 0.65-0.72% of their pixels over 2% with full cuts (docs/LIGHTCUTS.md,
+        // "The hidden side of the coin"). Its unshadowed estimate is the representative's
+        // M * G luminance times the cluster's (exact for grey lights).
+        float le = 0;
+        if (rss && !clear) {
+          if (visible && !boundary) le = luminance(est);
+          else if (found == CutVisibility::Occluded) le = shadow.unshadowed * luminance(n.intensity);
+        }
+        const float hideable = le * le;
         sumHideable += hideable;
         heapPush(heap, heapKey(b, uint32_t(nodes.size())));
         nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, left, right, n.rep, n.lights(),

@@ -58,7 +58,8 @@ inline const char* methodName(Method m) { return enumName(kMethodNames, m); }
 //     lower bound (what the estimate of an unoccluded cluster can be off by), for a
 //     first-order estimate scaled down where the point sees few shadow boundaries; a
 //     node with a visible representative also counts the part of its cluster that may be
-//     hidden, in proportion to how often the point's clusters turned out partly hidden
+//     hidden, and one with a hidden representative the part that may be visible, in
+//     proportion to how often the point's clusters turned out partly hidden
 //     (evaluator.cpp, kHiddenSharePerBoundary). The errors of a cut have random signs, so
 //     this keeps the total error, not just each node's, near errorRatio.
 enum class CutCriterion { Walter, Total };

@@ -166,10 +166,12 @@ std::string pergola(uint32_t seed, int lights) {
 // face's horizon (kExactSumMaxLights). Measured on this patio with full cuts: 3.7% of
 // pixels over 2% with the earlier weight (4), 1.9% with the coin weighed at 2.576 standard
 // deviations (a post's face +1.9% too bright), 0.5% with the straddling clusters' exact
-// sums as well.
+// sums as well; and 0.22% with the hidden side of the coin counted too (hundreds of hidden
+// representatives per point whose clusters are partly visible; 0.51% without it). Held to
+// 0.4%, within the 99.5% that scenes nobody tuned to must reach.
 TEST(Accuracy, LightcutsWithinTwoPercentUnderALattice) {
   io::ImageMetrics m = fullCutsAgainstBrute(Evaluated(pergola(4242, 6000)), 64, 64);
-  EXPECT_LE(m.fraction_over_threshold, 0.01) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
+  EXPECT_LE(m.fraction_over_threshold, 0.004) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
 }
 
 // Clusters proven clear (Visibility::boxClear) are refined without rays. With a zero
