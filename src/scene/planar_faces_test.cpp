@@ -262,14 +262,25 @@ TEST(PlanarFaces, SolidsClaimOnlySegmentsTheirTrianglesStop) {
   }
 }
 
+// The faces of a box from (-1, 0, -1) to (1, 1, 1), and its top quad's (y = 1).
+struct BoxTop {
+  OneMesh one;
+  PlanarFaces faces;
+  int top;
+  BoxTop() : one(mesh()), faces(one.shapes, one.meshes), top(faces.faceOf(0, 2 * 3)) {}
+  static Mesh mesh() {
+    Mesh m;
+    addBox(m, Vec3(-1, 0, -1), Vec3(1, 1, 1));
+    return m;
+  }
+};
+
 // A point in the face's plane, a grazing fan, one that turns away and a face beyond tMax
 // are not proven.
 TEST(PlanarFaces, PointsInThePlaneGrazingFansAndFarFacesAreNotProven) {
-  Mesh m;
-  addBox(m, Vec3(-1, 0, -1), Vec3(1, 1, 1));
-  OneMesh one(m);
-  PlanarFaces f(one.shapes, one.meshes);
-  const int top = f.faceOf(0, 2 * 3);  // the quad at y = 1
+  BoxTop box;
+  const PlanarFaces& f = box.faces;
+  const int top = box.top;
   ASSERT_GE(top, 0);
   Vec3 down[1] = {Vec3(0, -1, 0)};
   EXPECT_EQ(f.crossesAll(top, Vec3(0.2f, 3, 0.1f), down, 1, 10, 1e-3f), 1);
@@ -288,11 +299,9 @@ TEST(PlanarFaces, PointsInThePlaneGrazingFansAndFarFacesAreNotProven) {
 // rays are asked (-1): a point within the margin of the plane whose segments cross it on the
 // face (a wall just behind a window mesh). Beside the face: 0.
 TEST(PlanarFaces, PointsJustBehindAFaceAreLeftToTheRays) {
-  Mesh m;
-  addBox(m, Vec3(-1, 0, -1), Vec3(1, 1, 1));
-  OneMesh one(m);
-  PlanarFaces f(one.shapes, one.meshes);
-  const int top = f.faceOf(0, 2 * 3);  // the quad at y = 1
+  BoxTop box;
+  const PlanarFaces& f = box.faces;
+  const int top = box.top;
   ASSERT_GE(top, 0);
   const float margin = 1e-3f;
   Vec3 down[2] = {normalize(Vec3(0.3f, -1, 0)), normalize(Vec3(-0.2f, -1, 0.1f))};
