@@ -68,7 +68,8 @@ class PlanarFaces {
   // tMax: 1 yes, 0 not proven, -1 cannot tell (the mesh bounds no solid and is not one
   // face, or p is not surely outside it). A mesh open along one plane (a box without its
   // bottom) counts as closed by that plane, and a segment must leave it before tMax. A flat
-  // convex mesh of one face is asked crossesAll.
+  // convex mesh of one face is asked crossesAll, and what that does not prove is left to
+  // the rays (-1).
   int solidMeetsAll(int shape, const Vec3& p, const Vec3* dirs, int n, float tMax, float margin) const;
   // The face of a square shape (every square is one), or -1.
   int squareFace(int shape) const { return size_t(shape) < squareFace_.size() ? squareFace_[size_t(shape)] : -1; }

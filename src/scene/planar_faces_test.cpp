@@ -312,5 +312,25 @@ TEST(PlanarFaces, PointsJustBehindAFaceAreLeftToTheRays) {
   EXPECT_EQ(f.crossesAll(top, Vec3(0.999f, 1.0005f, 0), slant, 2, 10, margin), 0);  // one crosses beside it
 }
 
+// A flat convex mesh (a panel of two triangles) answers its probes as its one face where
+// that proves them, and leaves the rest to the rays (-1), never "not proven": before whole
+// regions, such a mesh of several faces sent every probe to the rays, which prove more
+// (no inset at the edges).
+TEST(PlanarFaces, AFlatConvexMeshLeavesWhatItsFaceCannotProveToTheRays) {
+  Mesh m;
+  m.positions = {Vec3(-1, 1, -1), Vec3(1, 1, -1), Vec3(1, 1, 1), Vec3(-1, 1, 1)};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  OneMesh one(m);
+  PlanarFaces f(one.shapes, one.meshes);
+  Vec3 down[2] = {normalize(Vec3(0.1f, -1, 0)), normalize(Vec3(-0.1f, -1, 0.1f))};
+  EXPECT_EQ(f.solidMeetsAll(0, Vec3(0, 3, 0), down, 2, 10, 1e-3f), 1);  // well inside
+  const int face = f.faceOf(0, 0);
+  ASSERT_GE(face, 0);
+  Vec3 edge[1] = {normalize(Vec3(0.9995f, 1, 0) - Vec3(0.9995f, 3, 0))};  // within the inset
+  EXPECT_EQ(f.crossesAll(face, Vec3(0.9995f, 3, 0), edge, 1, 10, 1e-3f), 0);
+  EXPECT_EQ(f.solidMeetsAll(0, Vec3(0.9995f, 3, 0), edge, 1, 10, 1e-3f), -1);
+  EXPECT_EQ(f.solidMeetsAll(0, Vec3(5, 3, 0), down, 2, 10, 1e-3f), -1);  // beside it: the rays say no
+}
+
 }  // namespace
 }  // namespace lc::scene
