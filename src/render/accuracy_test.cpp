@@ -51,10 +51,17 @@ std::string box(float x, float y, float z, float sx, float sy, float sz, float r
          ", box { material = " + mat + "; })))\n";
 }
 
-// A scene from .ray text, with brute force and lightcuts (default options) over its lights.
+// A scene from .ray text, with its object lights (luminous materials), and brute force and
+// lightcuts (default options) over its lights.
+std::unique_ptr<scene::Scene> buildWithObjectLights(const std::string& text) {
+  auto s = scene::Scene::build(io::parseRayString(text, "test.ray", "."));
+  lights::addObjectLights(*s, {});
+  return s;
+}
+
 struct Evaluated {
   explicit Evaluated(const std::string& text)
-      : scene(scene::Scene::build(io::parseRayString(text, "test.ray", "."))),
+      : scene(buildWithObjectLights(text)),
         brute(lightcuts::makeBruteForce(scene->lights())),
         forest(lightcuts::buildLightForest(scene->lights())),
         lc(lightcuts::makeLightcuts(scene->lights(), forest, lightcuts::CutOptions{})) {}
@@ -172,6 +179,62 @@ std::string pergola(uint32_t seed, int lights) {
 TEST(Accuracy, LightcutsWithinTwoPercentUnderALattice) {
   io::ImageMetrics m = fullCutsAgainstBrute(Evaluated(pergola(4242, 6000)), 64, 64);
   EXPECT_LE(m.fraction_over_threshold, 0.004) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
+}
+
+// A library as scripts/gen_library.py writes it: book stacks with slatted shelves, window
+// panels (object lights) on the back wall, and point lights, a third in lamp clusters over
+// the aisles and the rest 5 cm under the ceiling.
+std::string library(uint32_t seed, int lights) {
+  std::mt19937 rng(seed);
+  auto u = [&](float a, float b) { return std::uniform_real_distribution<float>(a, b)(rng); };
+  auto g = [&](float m, float sd) { return std::normal_distribution<float>(m, sd)(rng); };
+  const char* wall = "{ diffuse = (0.7, 0.68, 0.64); }";
+  const char* oak = "{ diffuse = (0.45, 0.3, 0.18); }";
+  std::string t = "SBT-raytracer 1.0\ncamera { position = (-3.6, 1.6, 4.2); look_at = (1.0, 1.1, -1.5); fov = 60; }\n";
+  t += box(0, -0.05f, 0, 10, 0.1f, 10, 0, "{ diffuse = (0.4, 0.32, 0.25); }") + box(0, 3.05f, 0, 10, 0.1f, 10, 0, wall);
+  t += box(-5, 1.5f, 0, 0.1f, 3, 10, 0, wall) + box(0, 1.5f, -5, 10, 3, 0.1f, 0, wall);
+  for (int i = 0; i < 4; ++i)
+    t += "translate(" + std::to_string(-3 + 2 * i) +
+         ", 1.9, -4.94, scale(0.9, 1.2, 1, square { material = { diffuse = (0, 0, 0); "
+         "luminosity = { colour = (0.8, 0.85, 1); intensity = 6; density = 40; }; }; }))\n";
+  for (int r = 0; r < 4; ++r) {
+    const float z = 1.5f - 1.4f * float(r);
+    for (float xs : {-2.5f, 0.5f}) {
+      t += box(xs - 1.2f, 1.1f, z, 0.04f, 2.2f, 0.4f, 0, oak) + box(xs + 1.2f, 1.1f, z, 0.04f, 2.2f, 0.4f, 0, oak);
+      for (int h = 0; h < 5; ++h) {
+        const float y = 0.1f + 0.5f * float(h);
+        for (int sl = 0; sl < 3; ++sl) t += box(xs, y, z - 0.13f + 0.13f * float(sl), 2.4f, 0.025f, 0.08f, 0, oak);
+        if (h < 4)
+          for (int b = std::uniform_int_distribution<int>(6, 14)(rng); b > 0; --b)
+            t += box(xs - 1.1f + u(0, 2.2f), y + 0.16f, z, 0.05f, 0.28f, 0.3f, 0, "{ diffuse = (0.5, 0.2, 0.15); }");
+      }
+    }
+  }
+  const float lampX[3] = {-1.0f, 2.2f, -4.0f};
+  for (int k = 0; k < lights; ++k) {
+    float x, y, z;
+    if (k % 3 == 0) {
+      const float zc = 2.2f - 1.4f * float(std::uniform_int_distribution<int>(0, 4)(rng));
+      x = g(lampX[std::uniform_int_distribution<int>(0, 2)(rng)], 0.1f), y = g(2.6f, 0.05f), z = g(zc, 0.1f);
+    } else {
+      x = u(-4.8f, 4.8f), y = 2.95f, z = u(-4.8f, 4.8f);
+    }
+    const float c = 5.0f / float(lights);
+    t += "point_light { position = (" + std::to_string(x) + "," + std::to_string(y) + "," + std::to_string(z) +
+         "); colour = (" + std::to_string(c) + "," + std::to_string(c * 0.95f) + "," + std::to_string(c * 0.85f) +
+         "); }\n";
+  }
+  return t;
+}
+
+// Seen from the library's ceiling, hundreds of refinements of clear clusters (the lights
+// just under it) and a few of the windows' small clusters, which a shelf's edge splits: the
+// visibility coin's rate is counted over the refinements of clusters that are not clear
+// (kHiddenSharePerBoundary, evaluator.cpp). Counted over all of them, the windows' clusters
+// were priced near zero and 2.0% of the pixels were over 2% (0.37% now).
+TEST(Accuracy, LightcutsWithinTwoPercentOnALibrarysCeiling) {
+  io::ImageMetrics m = fullCutsAgainstBrute(Evaluated(library(77, 2000)), 64, 42);
+  EXPECT_LE(m.fraction_over_threshold, 0.005) << "mean " << m.mean_relative_error << " p99 " << m.p99_relative_error;
 }
 
 // Clusters proven clear (Visibility::boxClear) are refined without rays. With a zero
