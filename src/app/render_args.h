@@ -38,6 +38,7 @@ struct RenderArgs {
   lightcuts::Estimator estimator = lightcuts::CutOptions{}.estimator;
   bool visibilityProbes = lightcuts::CutOptions{}.visibilityProbes;
   bool clearClusters = lightcuts::CutOptions{}.clearClusters;
+  bool secondSamples = lightcuts::CutOptions{}.secondSamples;
   std::string cutHeatmap;
   int referencePixels = 0;
   std::string errorFloor = "auto";

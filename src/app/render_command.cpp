@@ -278,6 +278,7 @@ void buildEvaluator(const RenderArgs& a, RenderSetup& s) {
   const scene::Scene& scene = *s.ls.scene;
   s.tb.sceneDiagonal = scene.bounds().diagonal();
   lightcuts::CutOptions co{s.error, a.maxCut, a.criterion, a.estimator, a.visibilityProbes, a.clearClusters};
+  co.secondSamples = a.secondSamples;
   co.stochasticCut = a.stochasticCut;
   co.seed = a.seed;
   if (s.method == lightcuts::Method::Brute) {
@@ -672,6 +673,13 @@ void addRenderCommand(CLI::App& app) {
                         "cluster); such clusters are refined without shadow rays and carry no visibility error "
                         "(on) or every representative casts its ray (off, as published); default {}",
                         switchName(d.clearClusters)))
+      ->group(cuts);
+  addSwitch(*c, "--second-samples", a->secondSamples,
+            fmt::format("Lightcuts: before a cut stops, a cluster whose representative is visible and whose estimate "
+                        "holds over a quarter of the error limit sends one ray to a second of its lights; where that "
+                        "one is hidden the cluster is refined as one on a shadow boundary (on), or its "
+                        "representative stands for it alone (off); default {}",
+                        switchName(d.secondSamples)))
       ->group(cuts);
   c->add_option("--reference-pixels", a->referencePixels,
                 fmt::format("Also run brute force at K pixels: report the measured error and the estimated "

@@ -54,6 +54,8 @@ void forEachEvalCounter(S& s, F&& f) {
   f("probed_clusters", s.probedClusters);
   f("probes_ruled_out", s.probesRuledOut);
   f("probe_rays", s.probeRays);
+  f("second_sample_rays", s.secondSamples);
+  f("second_samples_hidden", s.secondSamplesHidden);
   f("occluded_rays", s.occludedRays);
   f("hidden_clusters", s.hiddenClusters);
   f("clear_tests", s.clearTests);
@@ -183,6 +185,9 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["probed_clusters"] = es.probedClusters;
   j["probes_ruled_out"] = es.probesRuledOut;
   j["probe_rays"] = es.probeRays;
+  j["second_samples"] = switchName(a.secondSamples);
+  j["second_sample_rays"] = es.secondSamples;
+  j["second_samples_hidden"] = es.secondSamplesHidden;
   j["occluded_shadow_rays"] = es.occludedRays;
   j["hidden_clusters"] = es.hiddenClusters;
   j["clear_clusters"] = switchName(a.clearClusters);

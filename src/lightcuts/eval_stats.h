@@ -22,6 +22,11 @@ struct EvalStats {
   uint64_t probedClusters = 0;       // clusters tested for being hidden as a whole
   uint64_t probesRuledOut = 0;       // of those, failed before any ray (a corner misses the blocker's box)
   uint64_t probeRays = 0;            // the shadow rays those tests cast (in shadowRays too)
+  // Bright clusters whose visible representative was checked by a second light's ray before
+  // the cut stopped (kSecondSampleShare, evaluator.cpp; one ray each, in shadowRays too), and
+  // those of them found partly hidden.
+  uint64_t secondSamples = 0;
+  uint64_t secondSamplesHidden = 0;
   uint64_t occludedRays = 0;         // shadow rays that found their light hidden
   uint64_t hiddenClusters = 0;       // clusters kept in a cut as hidden by their probes
   uint64_t clearTests = 0;           // clusters tested for being visible as a whole (boxClear)
@@ -84,6 +89,8 @@ struct EvalStats {
     probedClusters += o.probedClusters;
     probesRuledOut += o.probesRuledOut;
     probeRays += o.probeRays;
+    secondSamples += o.secondSamples;
+    secondSamplesHidden += o.secondSamplesHidden;
     occludedRays += o.occludedRays;
     hiddenClusters += o.hiddenClusters;
     clearTests += o.clearTests;

@@ -105,6 +105,21 @@ constexpr double kVisibilityConfidence = 2.576;
 constexpr double kHiddenSharePerBoundary =
     kTotalFactor * kVisibilityConfidence * kTotalFactor * kVisibilityConfidence / 2;
 
+// A cluster whose representative is visible and whose estimate holds more than this share
+// of the cut's error limit gets a second sample of its visibility before the cut may stop:
+// the representative of its other child, one ray (which refining it would cast anyway).
+// Where that light is hidden the cluster is partly hidden, and it is counted as a node on a
+// shadow boundary (its whole upper bound as its spread, no coin), so the cut goes on. The
+// coin counts such errors by the point's boundary rate, as errors of random sign; but where
+// one edge runs along a row of clusters every representative on their paths can lie on its
+// visible side, no refinement splits, and each cluster keeps its hidden part's light, all of
+// one sign (a shelf's top across a window panel seen from a library's ceiling,
+// scripts/gen_library.py: 25-67% too much light in a dozen clusters of a failing point). A
+// quarter: few nodes are that bright once the cut is near its end (the 100k-light room has
+// none, the interiors a few per point), and one of them half hidden is an eighth of the
+// limit. (docs/LIGHTCUTS.md, "A second sample for bright clusters".)
+constexpr float kSecondSampleShare = 0.25f;
+
 // Clusters of fewer lights are refined rather than probed: up to eight corner rays cost
 // more than refining a small cluster does.
 constexpr uint32_t kProbeMinLights = 16;
@@ -239,6 +254,7 @@ class Lightcuts final : public LightEvaluator {
     float hideable;   // visible: its estimate's luminance squared, in sumHideable
     uint32_t blocker;  // the hint for its boxClear test
     int32_t exact;     // untested and small: its index in `exacts` once its U is known, else -1
+    bool sampledTwice = false;  // given its second sample (kSecondSampleShare)
   };
 
   static uint64_t heapKey(float bound, uint32_t index) {
@@ -443,6 +459,38 @@ class Lightcuts final : public LightEvaluator {
       }
     };
 
+    // Second samples for the bright clusters in the cut whose visible representative stands
+    // for them alone (kSecondSampleShare); true when one was found partly hidden and its
+    // spread raised to its upper bound (the criterion must be tested again).
+    auto secondSamples = [&](float limit) {
+      bool raised = false;
+      for (uint64_t key : heap) {
+        CutNode& cn = nodes[uint32_t(key)];
+        if (cn.sampledTwice || cn.hideable <= 0 || cn.shadow.found != CutVisibility::Visible ||
+            !(luminance(cn.estimate) > kSecondSampleShare * limit))
+          continue;
+        cn.sampledTwice = true;
+        const LightTree& tree = forest_.trees[cn.tree];
+        const uint32_t other = tree.repOf(tree.repOf(cn.left) == cn.rep ? cn.right : cn.left);
+        if (other == cn.rep) continue;
+        ShadowResult second;
+        const Light& l = lights_.lights[other];
+        shadowedUnit(l, lights_.groups[l.group], sp, vis, stats, second);
+        ++stats.secondSamples;
+        if (second.found != CutVisibility::Occluded && second.found != CutVisibility::Partial) continue;
+        ++stats.secondSamplesHidden;
+        double& sum = cn.scaled ? sumScaled : sumSq;
+        sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
+        sumHideable = std::max(0.0, sumHideable - double(cn.hideable));
+        cn.hideable = 0;
+        cn.scaled = false;
+        cn.spread = cn.upper;
+        sumSq += double(cn.spread) * cn.spread;
+        raised = true;
+      }
+      return raised;
+    };
+
     uint32_t cutRoots = 0;
     for (uint32_t t = 0; t < forest_.trees.size(); ++t) {
       const LightTree& tree = forest_.trees[t];
@@ -470,9 +518,11 @@ class Lightcuts final : public LightEvaluator {
         const double rate = double(refinedSplit) / std::max(1u, refinedTested);
         const double w = std::clamp(kSmoothSpreadPerBoundary * rate, kSmoothSpreadMin, 1.0);
         const double coinRate = double(refinedSplit) / std::max(1u, refinedTested - refinedClear);
-        if (sumSq + w * w * sumScaled + kHiddenSharePerBoundary * coinRate * sumHideable <=
-            rssFactor2 * double(limit) * limit)
-          break;
+        auto holds = [&] {
+          return sumSq + w * w * sumScaled + kHiddenSharePerBoundary * coinRate * sumHideable <=
+                 rssFactor2 * double(limit) * limit;
+        };
+        if (holds() && !(opt_.secondSamples && secondSamples(limit) && !holds())) break;
       }
       // Out of budget with the bound not met: the cut's error may exceed --error (counted,
       // and the render warns).

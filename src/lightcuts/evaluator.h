@@ -101,6 +101,11 @@ struct CutOptions {
   // the cluster and every cluster under it are known unoccluded: refining them casts no
   // shadow rays, and their error is their unshadowed bounds' alone.
   bool clearClusters = true;
+  // --second-samples: before the cut stops, a cluster whose representative is visible and
+  // whose estimate holds over a quarter of the error limit sends a ray to a second light
+  // (its other child's representative); if that one is hidden, the cluster counts as on a
+  // shadow boundary and the cut goes on (kSecondSampleShare, evaluator.cpp).
+  bool secondSamples = true;
   // --method stochastic: clusters in the cut, each giving one light drawn at random
   // (stochastic.cpp); its seed (render --seed).
   int stochasticCut = 64;
