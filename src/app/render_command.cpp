@@ -676,10 +676,10 @@ void addRenderCommand(CLI::App& app) {
       ->group(cuts);
   addSwitch(*c, "--second-samples", a->secondSamples,
             fmt::format("Lightcuts: before a cut stops, a cluster whose representative is visible and whose estimate "
-                        "holds over a quarter of the error limit sends one ray to a second of its lights; where that "
+                        "holds over {:g} of the error limit sends one ray to a second of its lights; where that "
                         "one is hidden the cluster is refined as one on a shadow boundary (on), or its "
                         "representative stands for it alone (off); default {}",
-                        switchName(d.secondSamples)))
+                        lightcuts::kSecondSampleShare, switchName(d.secondSamples)))
       ->group(cuts);
   c->add_option("--reference-pixels", a->referencePixels,
                 fmt::format("Also run brute force at K pixels: report the measured error and the estimated "

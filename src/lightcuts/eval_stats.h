@@ -23,7 +23,7 @@ struct EvalStats {
   uint64_t probesRuledOut = 0;       // of those, failed before any ray (a corner misses the blocker's box)
   uint64_t probeRays = 0;            // the shadow rays those tests cast (in shadowRays too)
   // Bright clusters whose visible representative was checked by a second light's ray before
-  // the cut stopped (kSecondSampleShare, evaluator.cpp; one ray each, in shadowRays too), and
+  // the cut stopped (kSecondSampleShare, evaluator.h; one ray each, in shadowRays too), and
   // those of them found partly hidden.
   uint64_t secondSamples = 0;
   uint64_t secondSamplesHidden = 0;

@@ -105,9 +105,11 @@ constexpr double kVisibilityConfidence = 2.576;
 constexpr double kHiddenSharePerBoundary =
     kTotalFactor * kVisibilityConfidence * kTotalFactor * kVisibilityConfidence / 2;
 
-// A cluster whose representative is visible and whose estimate holds more than this share
-// of the cut's error limit gets a second sample of its visibility before the cut may stop:
-// the representative of its other child, one ray (which refining it would cast anyway).
+// Second samples (kSecondSampleShare, evaluator.h): a cluster whose representative is
+// visible and whose estimate holds more than that share of the cut's error limit gets a
+// second sample of its visibility before the cut may stop: the representative of its other
+// child, one ray (refining the cluster later casts it again; few are refined: 334 of the
+// library's 73k second samples found their light hidden).
 // Where that light is hidden the cluster is partly hidden, and it is counted as a node on a
 // shadow boundary (its whole upper bound as its spread, no coin), so the cut goes on. The
 // coin counts such errors by the point's boundary rate, as errors of random sign; but where
@@ -118,7 +120,6 @@ constexpr double kHiddenSharePerBoundary =
 // quarter: few nodes are that bright once the cut is near its end (the 100k-light room has
 // none, the interiors a few per point), and one of them half hidden is an eighth of the
 // limit. (docs/LIGHTCUTS.md, "A second sample for bright clusters".)
-constexpr float kSecondSampleShare = 0.25f;
 
 // Clusters of fewer lights are refined rather than probed: up to eight corner rays cost
 // more than refining a small cluster does.
@@ -251,7 +252,8 @@ class Lightcuts final : public LightEvaluator {
     bool firstOrder;  // takes the first-order estimate (estimate.h) if it ends in the cut
     bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
     bool clear;       // no surface can hide any of its lights (Visibility::boxClear)
-    float hideable;   // visible: its estimate's luminance squared, in sumHideable
+    float hideable;   // its coin: the luminance squared of its estimate (visible) or of its
+                      // unshadowed estimate (hidden), in sumHideable
     uint32_t blocker;  // the hint for its boxClear test
     int32_t exact;     // untested and small: its index in `exacts` once its U is known, else -1
     bool sampledTwice = false;  // given its second sample (kSecondSampleShare)
@@ -346,8 +348,7 @@ class Lightcuts final : public LightEvaluator {
     Vec3d total;
     uint32_t cutSize = 0;
     // Sums of the squared spreads of the nodes in the heap: those scaled by the boundary
-    // rate, and the others; and of the squared estimates of those whose representative is
-    // visible (kHiddenSharePerBoundary).
+    // rate, and the others; and of their coins (CutNode::hideable, kHiddenSharePerBoundary).
     double sumSq = 0, sumScaled = 0, sumHideable = 0;
     // The boundary rate's counts, and how many of the refinements tested were of clear
     // clusters (whose children cannot disagree: kHiddenSharePerBoundary).

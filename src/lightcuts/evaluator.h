@@ -79,6 +79,10 @@ inline const char* cutCriterionName(CutCriterion c) { return enumName(kCutCriter
 // lights per pixel).
 constexpr float kCourseCutsDefaultError = 0.25f;
 
+// --second-samples: the share of the cut's error limit over which a cluster's estimate gets
+// a second sample of its visibility (CutOptions::secondSamples).
+constexpr float kSecondSampleShare = 0.25f;
+
 struct CutOptions {
   float errorRatio = 0.02f;  // --error: relative error threshold
   // --max-cut: most nodes in one cut, plus one per tree after the first. Past it a cut stops
@@ -102,9 +106,9 @@ struct CutOptions {
   // shadow rays, and their error is their unshadowed bounds' alone.
   bool clearClusters = true;
   // --second-samples: before the cut stops, a cluster whose representative is visible and
-  // whose estimate holds over a quarter of the error limit sends a ray to a second light
-  // (its other child's representative); if that one is hidden, the cluster counts as on a
-  // shadow boundary and the cut goes on (kSecondSampleShare, evaluator.cpp).
+  // whose estimate holds over kSecondSampleShare of the error limit sends a ray to a second
+  // light (its other child's representative); if that one is hidden, the cluster counts as
+  // on a shadow boundary and the cut goes on (evaluator.cpp says why).
   bool secondSamples = true;
   // --method stochastic: clusters in the cut, each giving one light drawn at random
   // (stochastic.cpp); its seed (render --seed).
