@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <utility>
+#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -639,6 +640,7 @@ class Lightcuts final : public LightEvaluator {
     for (uint64_t key : heap) {
       const CutNode& cn = nodes[uint32_t(key)];
       float factor = 1;
+      bool summed = false;  // a spot cluster estimated by its exact sum (CutRecord::summed)
       const LightTree& ctree = forest_.trees[cn.tree];
       if (firstOrder && !cn.firstOrder && cn.lower <= 0 && ctree.lightCount(cn.node) <= kExactSumMaxLights &&
           cn.shadow.found != CutVisibility::Occluded && cn.shadow.found != CutVisibility::Partial) {
@@ -651,6 +653,7 @@ class Lightcuts final : public LightEvaluator {
         total += exact;
         total -= cn.estimate;
         if (raw > 0 && le > 0) factor = std::clamp(le / raw, 0.5f, 2.0f);
+        summed = ctree.type == LightType::Spot;
       } else if (cn.firstOrder) {
         const LightTree& tree = forest_.trees[cn.tree];
         const LightNode& n = tree.nodes[cn.node];
@@ -667,7 +670,8 @@ class Lightcuts final : public LightEvaluator {
           factor = std::clamp(kept / raw, 0.5f, 2.0f);
         }
       }
-      if (record) record1(cn.tree, cn.node, cn.pre, cn.shadow.found, cn.firstOrder, factor);
+      // (A summed node's factor goes into `recorded` negated: factors are never 0.)
+      if (record) record1(cn.tree, cn.node, cn.pre, cn.shadow.found, cn.firstOrder, summed ? -factor : factor);
     }
     if (record) {
       // The cut: the nodes left in the heap, and the exact ones recorded as they came.
@@ -677,11 +681,13 @@ class Lightcuts final : public LightEvaluator {
       record->point = sp.p;
       record->entries.resize(recorded.size());
       record->factor.resize(recorded.size());
+      record->summed.resize(recorded.size());
       record->nodes.resize(recorded.size());
       record->treeBegin.assign(forest_.trees.size() + 1, uint32_t(recorded.size()));
       for (size_t i = recorded.size(); i-- > 0;) {
         record->entries[i] = uint32_t(recorded[i].key);
-        record->factor[i] = recorded[i].factor;
+        record->factor[i] = std::fabs(recorded[i].factor);
+        record->summed[i] = recorded[i].factor < 0;
         record->nodes[i] = recorded[i].node;
         record->treeBegin[recorded[i].key >> 32] = uint32_t(i);
       }

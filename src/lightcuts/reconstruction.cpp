@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "lightcuts/exact_sum.h"
+
 
 namespace lc::lightcuts {
 
@@ -71,6 +73,7 @@ inline void setState(uint32_t& state, int i, uint8_t v) {
 void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecord* const* samples, int count,
                MergedCut& out) {
   out.clear();
+  out.forest = &forest;
   count = std::clamp(count, 0, kMaxSamples);
   // Per sample: how many of its entries before each one are not visible with a
   // first-order estimate (CutRecord::rough), so that any run of entries can be checked at once.
@@ -212,12 +215,15 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       pos = nodeEnd;
       int visible = 0, occluded = 0, partial = 0, firstOrder = 0, exacts = 0;
       float factorSum = 0;
+      bool summed = false;
       for (int i = 0; i < count; ++i) {
         firstOrder += (stateOf(state, i) & kFirstOrderBit) != 0;
         if (exact >> i & 1) {
           const std::vector<float>& f = samples[i]->factor;
+          const std::vector<uint8_t>& su = samples[i]->summed;
           ++exacts;
           factorSum += exactAt[i] < f.size() ? f[exactAt[i]] : 1.0f;
+          summed |= exactAt[i] < su.size() && su[exactAt[i]] != 0;
         }
         auto s = CutVisibility(stateOf(state, i) & 3);
         visible += s == CutVisibility::Visible;
@@ -233,9 +239,10 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       bool needsRay = occluded > 0 || partial > 0 || visible == 0;
       const bool disagree = occluded > 0 || partial > 0;
       const float factor = firstOrder == count && exacts > 0 ? factorSum / float(exacts) : 1.0f;
-      const bool batched = !needsRay && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
+      const bool batched = !needsRay && !summed && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
       // The group and the batch wait for the pass below, which fetches the lights ahead.
-      out.nodes.push_back(MergedCut::Node{intensity, rep, needsRay, batched, disagree, factor, t, node});
+      out.nodes.push_back(MergedCut::Node{intensity, rep, needsRay, batched, disagree, summed ? 1.0f : factor, t, node,
+                                          summed});
     }
   }
   // The representatives' lights are scattered over the light array: a cache miss each when
@@ -285,8 +292,10 @@ namespace {
 
 // A node with one shadow ray: its representative's contribution, times the samples'
 // first-order factor where it is unoccluded.
-Color withRay(const LightSet& lights, const MergedCut::Node& node, const ShadingPoint& sp, Visibility& vis,
-              EvalStats& stats) {
+Color withRay(const LightSet& lights, const MergedCut& cut, const MergedCut::Node& node, const ShadingPoint& sp,
+              Visibility& vis, EvalStats& stats) {
+  if (node.summed && cut.forest)
+    return withVisibility(unshadowedSum(lights, cut.forest->trees[node.tree], node.node, sp), vis, stats, false);
   Color mg;
   Vec3 wi;
   float dist;
@@ -321,7 +330,7 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
   for (size_t i = 0; i < std::min(kAhead, rays.size()); ++i) __builtin_prefetch(&lights.lights[cut.nodes[rays[i]].rep]);
   for (size_t i = 0; i < rays.size(); ++i) {
     if (i + kAhead < rays.size()) __builtin_prefetch(&lights.lights[cut.nodes[rays[i + kAhead]].rep]);
-    total += withRay(lights, cut.nodes[rays[i]], sp, vis, stats);
+    total += withRay(lights, cut, cut.nodes[rays[i]], sp, vis, stats);
   }
   const size_t groups = cut.groupProbe.size();
   static thread_local std::vector<Color> groupSum;
@@ -345,7 +354,7 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
     stats.refutingGroupProbes += luminance(groupSum[g]) > refuting;
     total -= groupSum[g];
     for (size_t i = g * MergedCut::kGroupSize; i < std::min(cut.batchNodes.size(), (g + 1) * MergedCut::kGroupSize); ++i)
-      total += withRay(lights, cut.nodes[cut.batchNodes[i]], sp, vis, stats);
+      total += withRay(lights, cut, cut.nodes[cut.batchNodes[i]], sp, vis, stats);
   }
   // A hidden group that would hold a share worth checking (of the point's light, or of the
   // cut's error floor where the point is dark) gets its probe's ray; visible, the group's
@@ -362,7 +371,7 @@ ReconstructionResult evaluateMergedCut(const LightSet& lights, const MergedCut& 
     if (!(estimate > worthHidden) || !probeContradicts(wi, dist, false, vis, stats)) continue;
     stats.refutingGroupProbes += estimate > refutingHidden;
     for (size_t i = g * MergedCut::kGroupSize; i < std::min(cut.hidden.size(), (g + 1) * MergedCut::kGroupSize); ++i)
-      total += withRay(lights, cut.hidden[i], sp, vis, stats);
+      total += withRay(lights, cut, cut.hidden[i], sp, vis, stats);
   }
   uint32_t cutSize = uint32_t(cut.nodes.size()) + cut.occluded;
   stats.recordCut(cutSize);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include <functional>
@@ -530,6 +531,68 @@ TEST(Reconstruction, MergedCutTakesTheFinerEntryOnEachSide) {
   lc->mergeSamples(ba, 2, m2);
   ASSERT_EQ(m2.nodes.size(), 3u);
   for (size_t i = 0; i < 3; ++i) EXPECT_EQ(m2.nodes[i].node, m.nodes[i].node);
+}
+
+}  // namespace
+}  // namespace lc::lightcuts
+
+namespace lc::lightcuts {
+namespace {
+
+// Spots whose cone edges cross the receiver: a small cluster across an edge is a 0-or-all
+// sample of its representative, so the samples' cuts estimate it by its exact sum
+// (CutRecord::summed), and a point between them must too. Over 40 cells of four samples
+// 0.15 apart on the floor, the points between them against the exact sum (no occluders).
+TEST(Reconstruction, NodesTheSamplesSummedAreSummedBetweenThem) {
+  LightSet lights = cloud(800, LightType::Spot, 23);
+  lights.groups[0].falloff.cosCutoff = std::cos(0.3f);  // 17 degrees: footprints ~1.5 across
+  lights.groups[0].falloff.exponent = 1;
+  LightForest forest = buildLightForest(lights);
+  auto lc = makeLightcuts(lights, forest, CutOptions{});
+  auto brute = makeBruteForce(lights);
+  Rng rng(5, 1);
+  double errWith = 0, errWithout = 0, worstWith = 0;
+  int points = 0, summedNodes = 0;
+  for (int cell = 0; cell < 40; ++cell) {
+    const float x0 = rng.uniform() * 3 - 1.5f, z0 = rng.uniform() * 3 - 1.5f, d = 0.15f;
+    CutRecord recs[4];
+    for (int k = 0; k < 4; ++k) {
+      CountingVisibility v(open);
+      EvalStats st;
+      lc->evaluateRecorded(point(Vec3(x0 + d * (k & 1), 0, z0 + d * (k >> 1))), v, st, recs[k]);
+    }
+    const CutRecord* four[4] = {&recs[0], &recs[1], &recs[2], &recs[3]};
+    MergedCut with;
+    lc->mergeSamples(four, 4, with);
+    for (const MergedCut::Node& n : with.nodes) summedNodes += n.summed;
+    CutRecord plain[4];
+    for (int k = 0; k < 4; ++k) {
+      plain[k] = recs[k];
+      plain[k].summed.clear();  // as before summed nodes were recorded
+    }
+    const CutRecord* fourPlain[4] = {&plain[0], &plain[1], &plain[2], &plain[3]};
+    MergedCut without;
+    lc->mergeSamples(fourPlain, 4, without);
+    for (float u : {0.3f, 0.5f, 0.8f}) {
+      const ShadingPoint sp = point(Vec3(x0 + d * u, 0, z0 + d * (1 - u)));
+      CountingVisibility v(open);
+      EvalStats st;
+      const double exact = luminance(brute->evaluate(sp, v, st).radiance);
+      if (!(exact > 0)) continue;
+      const double a = std::fabs(luminance(lc->reconstruct(sp, v, st, with).radiance) / exact - 1);
+      const double b = std::fabs(luminance(lc->reconstruct(sp, v, st, without).radiance) / exact - 1);
+      errWith += a;
+      errWithout += b;
+      worstWith = std::max(worstWith, a);
+      ++points;
+    }
+  }
+  ASSERT_GT(points, 60);
+  EXPECT_GT(summedNodes, 40) << "cone edges cross the cells: some nodes are summed";
+  errWith /= points;
+  errWithout /= points;
+  EXPECT_LT(errWith, 0.5 * errWithout) << "mean error with summed nodes " << errWith << ", without " << errWithout;
+  EXPECT_LT(worstWith, 0.02);
 }
 
 }  // namespace
