@@ -124,14 +124,15 @@ constexpr double kHiddenSharePerBoundary =
 
 // A recorded cut marks the spot clusters it estimated by their exact sums (CutRecord::summed),
 // and the points between samples sum them too: a cone's step makes the representative a
-// 0-or-all sample there. Those walks cost up to 18% of a render where spots are many, and
-// most summed nodes are dim; so the dimmest are left unmarked, as long as their larger of
-// representative's estimate and exact sum at the sample (what either estimate can be off
-// by) adds up to at most this share of the cut's error limit: at most a quarter of the
-// error budget, as a group probe's half (reconstruction.h). A random room of 3,000 spots:
-// 303.5 -> 286.7 rays per point, 14.0 -> 12.3 s; an unseen theatre's pixels over 2% stay at
-// 0.11% (docs/LIGHTCUTS.md, "Spot clusters the samples summed").
-constexpr float kUnsummedShare = 0.25f;
+// 0-or-all sample there. Those walks cost a fifth to a third of a render where spots are
+// many, and most summed nodes are dim; so the dimmest are left unmarked, as long as their
+// larger of representative's estimate and exact sum at the sample (what either estimate
+// can be off by) adds up to at most this share of the cut's error limit: an eighth of the
+// error budget (a group probe's is half, reconstruction.h). A quarter left a bias of
+// -0.46% over an unseen theatre's stage (an eighth -0.29%, everything summed -0.14%); a
+// random room of 3,000 spots: 272.2 rays per point before summing, 303.5 with every node
+// summed, 292.0 with this (docs/LIGHTCUTS.md, "Spot clusters the samples summed").
+constexpr float kUnsummedShare = 0.125f;
 
 // Clusters of fewer lights are refined rather than probed: up to eight corner rays cost
 // more than refining a small cluster does.
