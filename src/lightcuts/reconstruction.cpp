@@ -241,8 +241,8 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       const float factor = firstOrder == count && exacts > 0 ? factorSum / float(exacts) : 1.0f;
       const bool batched = !needsRay && !summed && (tree.type == LightType::Omni || tree.type == LightType::Oriented);
       // The group and the batch wait for the pass below, which fetches the lights ahead.
-      out.nodes.push_back(MergedCut::Node{intensity, rep, needsRay, batched, disagree, summed ? 1.0f : factor, t, node,
-                                          summed});
+      // (A summed node's factor is 1: the sample that summed it used no first-order estimate.)
+      out.nodes.push_back(MergedCut::Node{intensity, rep, needsRay, batched, disagree, factor, t, node, summed});
     }
   }
   // The representatives' lights are scattered over the light array: a cache miss each when

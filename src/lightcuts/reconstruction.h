@@ -58,9 +58,10 @@ struct CutRecord {
   // Per entry: 1 where the node is a small cluster of spots that the sample estimated by its
   // exact unshadowed sum (across the surface's horizon or a cone's edge, exact_sum.h): a
   // spot's cone ends in a step, so its representative is a 0-or-all sample of the cluster
-  // there, and a point near the sample sums it too. Empty or shorter: none. (Omni and
-  // oriented clusters fade to 0 at the horizon; summing them at points as well cost the
-  // Roman hall ~20% of its render for 0.1% of p99 error: docs/LIGHTCUTS.md.)
+  // there, and a point near the sample sums it too (all but the dimmest, whose error adds up
+  // to at most an eighth of the cut's: kUnsummedShare, evaluator.cpp). Empty or shorter:
+  // none. (Omni and oriented clusters fade to 0 at the horizon; summing them at points as
+  // well cost the Roman hall ~20% of its render for 0.1% of p99 error: docs/LIGHTCUTS.md.)
   std::vector<uint8_t> summed;
   std::vector<uint32_t> treeBegin;  // entries of tree t: [treeBegin[t], treeBegin[t + 1])
   // entries.size() + 1 values: rough[k] = how many entries before entry k are not visible

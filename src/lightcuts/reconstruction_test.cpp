@@ -533,12 +533,6 @@ TEST(Reconstruction, MergedCutTakesTheFinerEntryOnEachSide) {
   for (size_t i = 0; i < 3; ++i) EXPECT_EQ(m2.nodes[i].node, m.nodes[i].node);
 }
 
-}  // namespace
-}  // namespace lc::lightcuts
-
-namespace lc::lightcuts {
-namespace {
-
 // Spots whose cone edges cross the receiver: a small cluster across an edge is a 0-or-all
 // sample of its representative, so the samples' cuts estimate it by its exact sum
 // (CutRecord::summed), and a point between them must too, all but the dimmest, whose
