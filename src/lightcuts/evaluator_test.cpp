@@ -302,6 +302,42 @@ TEST(Lightcuts, AClusterFacingAwayStopsAtItsExactSum) {
   EXPECT_GT(lcut->evaluateRecorded(sp, vis, sr, rec).cutSize, 2u);
 }
 
+// A chandelier: a tight clump of lights far above the points, with nothing between, which
+// the scene proves (Visibility::boxClear): its clusters are clear, their light within their
+// lower and upper bounds, which lie close together so far away. Ordered by their upper
+// bounds (Walter's rule), the clump's clusters were refined until each held under 2% of
+// the light, as if it could be hidden; ordered by their spreads, a full cut stops far
+// sooner, as close to brute force. A recorded cut keeps the upper bounds (reconstruction's
+// points borrow visibility from its finer clusters).
+struct AllClear : Unoccluded {
+  bool boxClear(const Vec3&, const Vec3&, uint32_t&) override { return true; }
+};
+
+TEST(Lightcuts, ClearClustersAreOrderedByTheirSpreads) {
+  LightSet s = cloud(3000, LightType::Omni, 12);
+  for (Light& l : s.lights) l.position = Vec3(0, 6, 0) + (l.position - Vec3(0, 2.5f, 0)) * 0.05f;
+  LightForest f = buildLightForest(s);
+  auto lcut = makeLightcuts(s, f, CutOptions{0.02f});
+  auto brute = makeBruteForce(s);
+  AllClear vis;
+  Rng r(5, 1);
+  uint64_t fullNodes = 0, recordedNodes = 0;
+  for (int i = 0; i < 20; ++i) {
+    ShadingPoint sp = point(Vec3(r.uniform() * 4 - 2, 0, r.uniform() * 4 - 2));
+    EvalStats sf, sr, sb;
+    EvalResult full = lcut->evaluate(sp, vis, sf);
+    CutRecord rec;
+    EvalResult recorded = lcut->evaluateRecorded(sp, vis, sr, rec);
+    const float want = luminance(brute->evaluate(sp, vis, sb).radiance);
+    EXPECT_NEAR(luminance(full.radiance), want, 0.02f * want) << i;
+    EXPECT_NEAR(luminance(recorded.radiance), want, 0.02f * want) << i;
+    EXPECT_GT(sf.clearedClusters, 0u);
+    fullNodes += full.cutSize;
+    recordedNodes += recorded.cutSize;
+  }
+  EXPECT_LT(double(fullNodes), 0.5 * double(recordedNodes)) << fullNodes << " " << recordedNodes;
+}
+
 // A cut that runs out of --max-cut nodes before its bound holds is counted; one that holds
 // its bound, or reaches every light, is not.
 TEST(Lightcuts, CountsCutsStoppedByTheBudget) {
