@@ -59,12 +59,19 @@ inline Lanes3 maxStd(const Lanes3& a, const Lanes3& b) { return {maxStd(a.x, b.x
 // mask ? a : b, lane by lane.
 inline __m128 select(__m128 mask, __m128 a, __m128 b) { return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b)); }
 
+// A frame's axes in every lane.
+struct FrameLanes {
+  Lanes3 u, v, w, au, av, aw;
+  explicit FrameLanes(const Frame& f)
+      : u(splat(f.u)), v(splat(f.v)), w(splat(f.w)), au(splat(f.au)), av(splat(f.av)), aw(splat(f.aw)) {}
+};
+
 // RotatedBox(f, c, h).cosUpper() and its cz - hz (cosLower's numerator).
-inline __m128 cosUpperLanes(const Frame& f, const Lanes3& c, const Lanes3& h, __m128& minZ) {
+inline __m128 cosUpperLanes(const FrameLanes& f, const Lanes3& c, const Lanes3& h, __m128& minZ) {
   const __m128 zero = _mm_setzero_ps();
-  const __m128 cx = dot(c, splat(f.u)), hx = dot(splat(f.au), h);
-  const __m128 cy = dot(c, splat(f.v)), hy = dot(splat(f.av), h);
-  const __m128 cz = dot(c, splat(f.w)), hz = dot(splat(f.aw), h);
+  const __m128 cx = dot(c, f.u), hx = dot(f.au, h);
+  const __m128 cy = dot(c, f.v), hy = dot(f.av, h);
+  const __m128 cz = dot(c, f.w), hz = dot(f.aw, h);
   minZ = _mm_sub_ps(cz, hz);
   const __m128 mz = _mm_add_ps(cz, hz);
   const __m128 ax = _mm_sub_ps(absLanes(cx), hx), ay = _mm_sub_ps(absLanes(cy), hy);
@@ -86,18 +93,34 @@ inline __m128 attenLanes(const Attenuation& a, __m128 d, __m128& den) {
 }  // namespace detail
 #endif
 
+// What clusterBoundsPair needs of a shading point, its frames' axes and position set in
+// every lane once per cut rather than once per pair (they were a sixth of its work).
+struct PairFrames {
+  const ShadingPoint& sp;
+  const BoundFrames& fr;
+#if defined(__SSE2__)
+  detail::FrameLanes n, r;
+  detail::Lanes3 p;
+  PairFrames(const ShadingPoint& s, const BoundFrames& f)
+      : sp(s), fr(f), n(f.n), r(f.r), p(detail::splat(s.p)) {}
+#else
+  PairFrames(const ShadingPoint& s, const BoundFrames& f) : sp(s), fr(f) {}
+#endif
+};
+
 // clusterBounds(a, ...) and clusterBounds(b, ...), each with its lower bound and smoothness.
 inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType type, const LightGroup& g,
-                              const ShadingPoint& sp, const BoundFrames& fr, ChildBounds out[2]) {
+                              const PairFrames& pf, ChildBounds out[2]) {
+  const ShadingPoint& sp = pf.sp;
 #if defined(__SSE2__)
   using namespace detail;
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), slack = _mm_set1_ps(kCosSlack);
-  const Lanes3 p = splat(sp.p);
+  const Lanes3& p = pf.p;
   const Lanes3 lo = pairOf(a.lo, b.lo) - p, hi = pairOf(a.hi, b.hi) - p;
   const __m128 half = _mm_set1_ps(0.5f);
   const Lanes3 c = (lo + hi) * half, h = (hi - lo) * half;
   __m128 nMinZ;
-  const __m128 cN = cosUpperLanes(fr.n, c, h, nMinZ);
+  const __m128 cN = cosUpperLanes(pf.n, c, h, nMinZ);
   const __m128 behind = _mm_cmple_ps(cN, zero);  // every light behind the surface: 0
   const Lanes3 far = maxStd(absLanes(lo), absLanes(hi));
   const __m128 dMax = _mm_sqrt_ps(dot(far, far));
@@ -113,7 +136,7 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
   __m128 cRUpSlack = zero, cRLo = zero;
   if (specular) {
     __m128 rMinZ;
-    const __m128 cRUp = cosUpperLanes(fr.r, c, h, rMinZ);
+    const __m128 cRUp = cosUpperLanes(pf.r, c, h, rMinZ);
     cRUpSlack = minStd(one, _mm_add_ps(cRUp, slack));
     cRLo = _mm_and_ps(_mm_cmpgt_ps(cNLo, zero), maxStd(zero, _mm_div_ps(rMinZ, dMax)));
     smooth = _mm_and_ps(smooth, _mm_cmpgt_ps(cRLo, zero));
@@ -197,8 +220,13 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
   }
 #else
   for (int k = 0; k < 2; ++k)
-    out[k].upper = clusterBounds(k ? b : a, type, g, sp, fr, &out[k].lower, &out[k].smooth);
+    out[k].upper = clusterBounds(k ? b : a, type, g, sp, pf.fr, &out[k].lower, &out[k].smooth);
 #endif
+}
+
+inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType type, const LightGroup& g,
+                              const ShadingPoint& sp, const BoundFrames& fr, ChildBounds out[2]) {
+  clusterBoundsPair(a, b, type, g, PairFrames(sp, fr), out);
 }
 
 }  // namespace lc::lightcuts

@@ -356,6 +356,7 @@ class Lightcuts final : public LightEvaluator {
     nodes.clear();
     exacts.clear();
     BoundFrames frames(sp);
+    const PairFrames pairFrames(sp, frames);
     // The cut's estimate, in double: refinement subtracts a node's estimate and adds its
     // children's thousands of times, and the stopping rule compares against it.
     Vec3d total;
@@ -626,7 +627,7 @@ class Lightcuts final : public LightEvaluator {
       ChildBounds pair[2];
       const bool paired =
           !isLeafRef(cn.left) && !isLeafRef(cn.right) && boundsPairApplies(tree.type, tree.mixedGroups);
-      if (paired) clusterBoundsPair(tree.nodes[cn.left], tree.nodes[cn.right], tree.type, tree.bound, sp, frames, pair);
+      if (paired) clusterBoundsPair(tree.nodes[cn.left], tree.nodes[cn.right], tree.type, tree.bound, pairFrames, pair);
       addNode(cn.tree, cn.left, LightNode::leftPre(cn.pre), units[0], shadows[0], boundary, cnClear, blocker,
               paired ? &pair[0] : nullptr);
       addNode(cn.tree, cn.right, cn.rightPre, units[1], shadows[1], boundary, cnClear, blocker,
