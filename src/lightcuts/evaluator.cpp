@@ -756,6 +756,12 @@ class Lightcuts final : public LightEvaluator {
     Vec3 dirs[8];
     float dists[8];
     int m = 0;
+    // A corner whose ray cannot meet the blocker's box before dMin cannot be hidden by it:
+    // the probe would fail there, so it fails now, before any ray (a thin upright in front
+    // of a wide cluster). The same answers as the rays', for fewer rays. Tested corner by
+    // corner as their directions are made: most probes end at the first or second.
+    Vec3 blo, bhi;
+    const bool boxed = vis.blockerBox(rep.blocker, blo, bhi);
     for (int k = 0; k < 8; ++k) {
       // A flat box has only four distinct corners: the others repeat them.
       if (((k & 1) && n.lo.x == n.hi.x) || ((k & 2) && n.lo.y == n.hi.y) || ((k & 4) && n.lo.z == n.hi.z)) continue;
@@ -764,18 +770,12 @@ class Lightcuts final : public LightEvaluator {
       dists[m] = length(d);
       dirs[m] = d / dists[m];
       if (!(dot(dirs[m], sp.n) > 0)) return false;
+      if (boxed && !segmentMeetsBox(sp.p, dirs[m], dMin, blo, bhi)) {
+        ++stats.probesRuledOut;
+        return false;
+      }
       ++m;
     }
-    // A corner whose ray cannot meet the blocker's box before dMin cannot be hidden by it:
-    // the probe would fail there, so it fails now, before any ray (a thin upright in front
-    // of a wide cluster). The same answers as the rays', for fewer rays.
-    Vec3 blo, bhi;
-    if (vis.blockerBox(rep.blocker, blo, bhi))
-      for (int i = 0; i < m; ++i)
-        if (!segmentMeetsBox(sp.p, dirs[i], dMin, blo, bhi)) {
-          ++stats.probesRuledOut;
-          return false;
-        }
     // A blocker whose shape is known (a box, sphere, capped cylinder, square, convex mesh or
     // a mesh's flat face) is asked directly whether it stops every corner's segment: no rays.
     switch (vis.blocksAll(rep.blocker, dirs, m, dMin)) {
