@@ -471,7 +471,7 @@ class Lightcuts final : public LightEvaluator {
         // any other's by its upper bound (it may be partly hidden, whatever its
         // representative found). Ordered by their upper bounds, clear clusters were refined
         // as if they could hide their light: 484 of the 100k-light room's 896 refinements a
-        // point, 327 now (docs/LIGHTCUTS.md, "Clear clusters ordered by their spreads").
+        // point, 326 now (docs/LIGHTCUTS.md, "Clear clusters ordered by their spreads").
         // Not in recorded cuts: a reconstruction's points borrow visibility from its samples,
         // and a sample's finer clear clusters are what shows a shadow between them (the
         // Cornell box at 64 x 64 in cells of 4: 0.29% -> 1.34% of pixels over 2%).
