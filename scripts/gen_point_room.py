@@ -7,7 +7,8 @@ shadow ray: no object lights, no GI, nothing but point lights.
 
   /usr/bin/python3 scripts/gen_point_room.py [N] OUT.ray
 
-N may be written 100000, 100k, 1M. Deterministic (a fixed seed).
+N may be written 100000, 100k, 1M. Deterministic (a fixed seed). The room is bright: render
+with --exposure -4 to look at it.
 """
 import os
 import random
