@@ -104,6 +104,57 @@ struct Hull {
     float x2 = ax > 0 ? ax * ax : 0, y2 = ay > 0 ? ay * ay : 0;
     return mz * mz < cos2Angle * (x2 + y2 + mz * mz);  // mz < cos * length, both sides >= 0
   }
+  // The hull's faces through the apex: the planes through it and the box's silhouette
+  // edges (seen from the apex, an edge between a face that faces it and one that does
+  // not), each with the box on its inner side. With the world axes (the box's far faces)
+  // they are all the hull's face normals; a piece beyond one of them is apart, though
+  // its box meets the hull's bounding box and the cone around it (a canopy beside the
+  // wedge from a point to a long row of lights). Set up when first needed.
+  mutable int silhouette = -1;  // -1 not set up, else the number of planes
+  mutable Vec3 sn[6];
+  mutable float sd[6];
+  void setUpSilhouette() const {
+    silhouette = 0;
+    if (!(invDMin > 0)) return;  // the apex in or at the box: no such planes
+    const Vec3 blo = c - h, bhi = c + h;
+    // The planes' rounding: the box's corners lie on them to within this.
+    const float tol = 1e-5f * (maxComponent(vabs(apex)) + maxComponent(vabs(c)) + maxComponent(h));
+    for (int k = 0; k < 3; ++k) {
+      const int a = (k + 1) % 3, b = (k + 2) % 3;  // the edge runs along k
+      for (int sa = 0; sa < 2; ++sa)
+        for (int sb = 0; sb < 2; ++sb) {
+          const bool fa = sa ? apex[a] > bhi[a] : apex[a] < blo[a];
+          const bool fb = sb ? apex[b] > bhi[b] : apex[b] < blo[b];
+          if (fa == fb) continue;
+          Vec3 p0, p1;
+          p0[a] = p1[a] = sa ? bhi[a] : blo[a];
+          p0[b] = p1[b] = sb ? bhi[b] : blo[b];
+          p0[k] = blo[k];
+          p1[k] = bhi[k];
+          Vec3 n = cross(p0 - apex, p1 - apex);
+          const float len = length(n);
+          if (!(len > 0) || !std::isfinite(len)) continue;
+          n = n / len;
+          float d = dot(n, apex);
+          if (dot(n, c) > d) {
+            n = -n;
+            d = -d;
+          }
+          if (silhouette == 6) return;
+          sn[silhouette] = n;
+          sd[silhouette] = d + tol;
+          ++silhouette;
+        }
+    }
+  }
+  // Whether box b lies beyond one of those planes (by more than the margin).
+  bool silhouetteApart(const Bounds3& b) const {
+    if (silhouette < 0) setUpSilhouette();
+    const Vec3 bc = (b.lo + b.hi) * 0.5f, bh = (b.hi - b.lo) * 0.5f;
+    for (int i = 0; i < silhouette; ++i)
+      if (dot(sn[i], bc) - dot(vabs(sn[i]), bh) > sd[i] + margin) return true;
+    return false;
+  }
   // Whether a plane through the apex and an edge of triangle v separates it from the box:
   // the hull meets that plane only at the apex, the triangle lies on its other side.
   bool triangleApart(const Vec3* v) const {
@@ -236,7 +287,7 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
     if (hull.boxApart(q.box)) return true;
     for (int k = 0; k < q.axes; ++k)
       if (hull.axisApart(q.axis[k], q.lo[k], q.hi[k])) return true;
-    return false;
+    return hull.silhouetteApart(q.box);
   }
   const Mesh& m = (*meshes_)[size_t(s.mesh)];
   const auto& tri = m.triangles[p.prim];
@@ -256,7 +307,7 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
     pad(lo, hi);
     if (hull.axisApart(n, lo, hi)) return true;
   }
-  return hull.coneApart(b) || hull.triangleApart(v);
+  return hull.coneApart(b) || hull.triangleApart(v) || hull.silhouetteApart(b);
 }
 
 bool OccluderIndex::clear(const Vec3& apex, const Vec3& lo, const Vec3& hi, float margin, float shortfall,

@@ -98,6 +98,33 @@ TEST(OccluderIndex, RoomInteriorIsClearPillarIsNot) {
   EXPECT_FALSE(s->occluders().clear(apex, Vec3(-3, 3, -3), Vec3(-2, 4.2f, -2), 0.1f * eps));
 }
 
+// A row of lights (a string, a strip) seen from a point: the segments to it fill a thin
+// wedge. A box beside the wedge overlaps its bounding box on every axis, and the cone around
+// a row that long is too wide to use; only the wedge's own faces (the planes through the
+// point and the row's silhouette edges) set it apart. A box in the wedge is not apart.
+TEST(OccluderIndex, ABoxBesideTheWedgeToARowOfLightsIsApart) {
+  auto sceneWith = [](Vec3 c) {
+    io::SceneDesc d;
+    d.materials.emplace_back();
+    d.objects.push_back(object(ShapeKind::Box, Mat4::translate(c.x, c.y, c.z) * Mat4::scale(0.3f, 0.3f, 0.1f)));
+    return Scene::build(d);
+  };
+  const Vec3 apex(0, 0, 0), lo(-3, 3, -0.1f), hi(3, 3.1f, 0.1f);
+  auto beside = sceneWith(Vec3(2.5f, 0.5f, 0));
+  EXPECT_TRUE(beside->occluders().clear(apex, lo, hi, 1e-5f));
+  auto inside = sceneWith(Vec3(0.2f, 1.5f, 0));
+  EXPECT_FALSE(inside->occluders().clear(apex, lo, hi, 1e-5f));
+  // Every segment to the row misses the box beside it, and some meet the one inside.
+  int met = 0;
+  for (int k = 0; k <= 60; ++k) {
+    const Vec3 target(-3 + 0.1f * float(k), 3.05f, 0);
+    const float dist = length(target - apex);
+    EXPECT_FALSE(beside->occluded(apex, (target - apex) / dist, dist));
+    met += inside->occluded(apex, (target - apex) / dist, dist);
+  }
+  EXPECT_GT(met, 0);
+}
+
 // Lights on a surface (VPLs, an emitter's samples): the segments end short of them, so the
 // surface they lie on is apart from the segments though the box touches it.
 TEST(OccluderIndex, ShortfallSetsApartTheSurfaceTheLightsLieOn) {
