@@ -135,11 +135,12 @@ struct Hull {
           const float len = length(n);
           if (!(len > 0) || !std::isfinite(len)) continue;
           n = n / len;
-          float d = dot(n, apex);
-          if (dot(n, c) > d) {
-            n = -n;
-            d = -d;
-          }
+          if (dot(n, c) > dot(n, apex)) n = -n;
+          // The plane's offset bounds the apex and the whole box as computed: an edge as
+          // short as the coordinates' rounding (a wall's lights make a box one ulp thick)
+          // gives a normal made of rounding, and then the box's far corners, not the edge,
+          // set the offset (OccluderIndex.ANearlyFlatBoxGivesNoFalsePlanes).
+          const float d = std::max(dot(n, apex), dot(n, c) + dot(vabs(n), h));
           if (silhouette == 6) return;
           sn[silhouette] = n;
           sd[silhouette] = d + tol;

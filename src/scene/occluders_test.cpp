@@ -125,6 +125,27 @@ TEST(OccluderIndex, ABoxBesideTheWedgeToARowOfLightsIsApart) {
   EXPECT_GT(met, 0);
 }
 
+// A wall's lights make a box as thin as their coordinates' rounding (559.2 +- one ulp).
+// Its edges across that thickness are a ten-thousandth of a unit long: a plane through the
+// apex and such an edge takes its direction from rounding, and the Cornell box's ceiling
+// saw a garbage plane that left the box's far corners 2.5 units outside it. A piece in
+// the hull beyond that plane (here halfway from the apex to such a corner) was set apart,
+// and lights behind the tall block were counted visible. The planes' offsets now bound
+// the box as computed, whatever the edge.
+TEST(OccluderIndex, ANearlyFlatBoxGivesNoFalsePlanes) {
+  const Vec3 apex(554.265869f, 260.986328f, 7.51021242f);
+  const Vec3 c(208.84201f, 408.202271f, 559.200012f), h(206.841919f, 135.487549f, 6.10351562e-05f);
+  const Vec3 corner(c.x + h.x, c.y + h.y, c.z);
+  const Vec3 mid = (apex + corner) * 0.5f;
+  io::SceneDesc d;
+  d.materials.emplace_back();
+  d.objects.push_back(object(ShapeKind::Box, Mat4::translate(mid.x, mid.y, mid.z) * Mat4::scale(0.5f, 0.5f, 0.5f)));
+  auto s = Scene::build(d);
+  const Vec3 dir = corner - apex;
+  ASSERT_TRUE(s->occluded(apex, dir / length(dir), length(dir)));
+  EXPECT_FALSE(s->occluders().clear(apex, c - h, c + h, 1e-3f));
+}
+
 // Lights on a surface (VPLs, an emitter's samples): the segments end short of them, so the
 // surface they lie on is apart from the segments though the box touches it.
 TEST(OccluderIndex, ShortfallSetsApartTheSurfaceTheLightsLieOn) {
