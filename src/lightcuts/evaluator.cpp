@@ -472,9 +472,10 @@ class Lightcuts final : public LightEvaluator {
         // representative found). Ordered by their upper bounds, clear clusters were refined
         // as if they could hide their light: 484 of the 100k-light room's 896 refinements a
         // point, 326 now (docs/LIGHTCUTS.md, "Clear clusters ordered by their spreads").
-        // Not in recorded cuts: a reconstruction's points borrow visibility from its samples,
-        // and a sample's finer clear clusters are what shows a shadow between them (the
-        // Cornell box at 64 x 64 in cells of 4: 0.29% -> 1.34% of pixels over 2%).
+        // Not in recorded cuts: a cluster clear from the sample may be partly hidden from the
+        // points between samples that use its cut, where one ray decides its visibility, and
+        // only its upper bound limits that error (the Cornell box at 64 x 64 in cells of 4:
+        // 0.29% -> 1.34% of pixels over 2%, and 1.37% with a ray for every node).
         heapPush(heap, heapKey(clear && !record ? spread : b, uint32_t(nodes.size())));
         nodes.push_back(CutNode{t, ni, unit, est, spread, lo, b, shadow, left, right, n.rep, n.lights(),
                                 pre, n.rightPre(pre), fo, scaled, clear, hideable, blocker, -1});
