@@ -117,7 +117,7 @@ struct Hull {
     silhouette = 0;
     if (!(invDMin > 0)) return;  // the apex in or at the box: no such planes
     const Vec3 blo = c - h, bhi = c + h;
-    // The planes' rounding: the box's corners lie on them to within this.
+    // The rounding of the planes' dot products (their offsets are padded by it).
     const float tol = 1e-5f * (maxComponent(vabs(apex)) + maxComponent(vabs(c)) + maxComponent(h));
     for (int k = 0; k < 3; ++k) {
       const int a = (k + 1) % 3, b = (k + 2) % 3;  // the edge runs along k
@@ -125,7 +125,7 @@ struct Hull {
         for (int sb = 0; sb < 2; ++sb) {
           const bool fa = sa ? apex[a] > bhi[a] : apex[a] < blo[a];
           const bool fb = sb ? apex[b] > bhi[b] : apex[b] < blo[b];
-          if (fa == fb) continue;
+          if (fa == fb || silhouette == 6) continue;
           Vec3 p0, p1;
           p0[a] = p1[a] = sa ? bhi[a] : blo[a];
           p0[b] = p1[b] = sb ? bhi[b] : blo[b];
@@ -141,7 +141,6 @@ struct Hull {
           // gives a normal made of rounding, and then the box's far corners, not the edge,
           // set the offset (OccluderIndex.ANearlyFlatBoxGivesNoFalsePlanes).
           const float d = std::max(dot(n, apex), dot(n, c) + dot(vabs(n), h));
-          if (silhouette == 6) return;
           sn[silhouette] = n;
           sd[silhouette] = d + tol;
           ++silhouette;
