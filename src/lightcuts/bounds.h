@@ -90,6 +90,17 @@ struct RotatedBox {
     float x2 = ax > 0 ? ax * ax : 0, y2 = ay > 0 ? ay * ay : 0;
     return std::min(1.0f, mz / std::sqrt(x2 + y2 + mz * mz));
   }
+  // Lower bound of the cosine over the box's nearest z: z / sqrt(x^2 + y^2 + z^2) grows with z
+  // and falls with x^2 + y^2, so it is least at z = cz - hz with |x|, |y| at their largest;
+  // 0 when some vector may be at 90 degrees or more. Tighter than the smallest z over the
+  // longest vector when the box is seen nearly head-on: a box of 1 straight above a point 3
+  // away, 0.96 rather than 0.70 (clusterBounds takes the larger of the two).
+  float nearLowerCos() const {
+    float minZ = cz - hz;
+    if (minZ <= 0) return 0;
+    float bx = std::fabs(cx) + hx, by = std::fabs(cy) + hy;
+    return minZ / std::sqrt(bx * bx + by * by + minZ * minZ);
+  }
   // Lower bound (as cosLowerBoundBox); 0 when some vector may be at 90 degrees or more.
   float cosLower() const {
     float minZ = cz - hz;
@@ -172,9 +183,11 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
   // Nearest and farthest vectors of the box: |q| lies in [dMin, dMax] for all of them.
   float dMax = length(vmax(vabs(lo), vabs(hi)));
   float dMin = std::sqrt(dot(vmax(vmax(lo, -hi), Vec3(0.0f)), vmax(vmax(lo, -hi), Vec3(0.0f))));
-  // Lower cosine bounds: the smallest projection over the longest vector. Lights that may
-  // be behind the surface give nothing at all, so no lower bound then (specular neither).
-  float cNLo = lower && dMax > 0 ? std::max(0.0f, (bn.cz - bn.hz) / dMax) : 0.0f;
+  // Lower cosine bounds: the smallest projection over the longest vector, or over the
+  // longest the nearest projection can come with (RotatedBox::nearLowerCos), the larger.
+  // Lights that may be behind the surface give nothing at all, so no lower bound then
+  // (specular neither).
+  float cNLo = lower && dMax > 0 ? std::max(std::max(0.0f, (bn.cz - bn.hz) / dMax), bn.nearLowerCos()) : 0.0f;
   if (lower && directional) cNLo = std::max(cNLo, un.lo);
   bool specular = !g.diffuseOnly && sp.hasSpecular();
   Color mUp = sp.kd * std::min(1.0f, cN + kCosSlack);
@@ -192,7 +205,7 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
       cRUp = std::max(0.0f, std::min(cRUp, ur.up));
     }
     mUp += sp.ks * powNonNegative(std::min(1.0f, cRUp + kCosSlack), sp.shininess);
-    float cRLo = cNLo > 0 ? std::max(0.0f, (br.cz - br.hz) / dMax) : 0.0f;
+    float cRLo = cNLo > 0 ? std::max(std::max(0.0f, (br.cz - br.hz) / dMax), br.nearLowerCos()) : 0.0f;
     if (cNLo > 0 && directional) cRLo = std::max(cRLo, ur.lo);
     if (cNLo > 0) mLo += sp.ks * powNonNegative(cRLo, sp.shininess);
     sm = sm && cRLo > 0;

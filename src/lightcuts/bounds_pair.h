@@ -66,13 +66,19 @@ struct FrameLanes {
       : u(splat(f.u)), v(splat(f.v)), w(splat(f.w)), au(splat(f.au)), av(splat(f.av)), aw(splat(f.aw)) {}
 };
 
-// RotatedBox(f, c, h).cosUpper() and its cz - hz (cosLower's numerator).
-inline __m128 cosUpperLanes(const FrameLanes& f, const Lanes3& c, const Lanes3& h, __m128& minZ) {
+// RotatedBox(f, c, h).cosUpper(), its cz - hz (the lower bounds' numerator) and its
+// nearLowerCos() (0 where cz - hz <= 0).
+inline __m128 cosUpperLanes(const FrameLanes& f, const Lanes3& c, const Lanes3& h, __m128& minZ, __m128& lowerCos) {
   const __m128 zero = _mm_setzero_ps();
   const __m128 cx = dot(c, f.u), hx = dot(f.au, h);
   const __m128 cy = dot(c, f.v), hy = dot(f.av, h);
   const __m128 cz = dot(c, f.w), hz = dot(f.aw, h);
   minZ = _mm_sub_ps(cz, hz);
+  {
+    const __m128 bx = _mm_add_ps(absLanes(cx), hx), by = _mm_add_ps(absLanes(cy), hy);
+    const __m128 s = _mm_add_ps(_mm_add_ps(_mm_mul_ps(bx, bx), _mm_mul_ps(by, by)), _mm_mul_ps(minZ, minZ));
+    lowerCos = _mm_and_ps(_mm_cmpgt_ps(minZ, zero), _mm_div_ps(minZ, _mm_sqrt_ps(s)));
+  }
   const __m128 mz = _mm_add_ps(cz, hz);
   const __m128 ax = _mm_sub_ps(absLanes(cx), hx), ay = _mm_sub_ps(absLanes(cy), hy);
   const __m128 x2 = _mm_and_ps(_mm_cmpgt_ps(ax, zero), _mm_mul_ps(ax, ax));
@@ -120,8 +126,8 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
   const Lanes3 lo = pairOf(a.lo, b.lo) - p, hi = pairOf(a.hi, b.hi) - p;
   const __m128 half = _mm_set1_ps(0.5f);
   const Lanes3 c = (lo + hi) * half, h = (hi - lo) * half;
-  __m128 nMinZ;
-  const __m128 cN = cosUpperLanes(pf.n, c, h, nMinZ);
+  __m128 nMinZ, nLowerCos;
+  const __m128 cN = cosUpperLanes(pf.n, c, h, nMinZ, nLowerCos);
   const __m128 behind = _mm_cmple_ps(cN, zero);  // every light behind the surface: 0
   const Lanes3 far = maxStd(absLanes(lo), absLanes(hi));
   const __m128 dMax = _mm_sqrt_ps(dot(far, far));
@@ -129,17 +135,17 @@ inline void clusterBoundsPair(const LightNode& a, const LightNode& b, LightType 
                              Lanes3{zero, zero, zero});
   const __m128 dMin = _mm_sqrt_ps(dot(near, near));
   const __m128 dMaxPositive = _mm_cmpgt_ps(dMax, zero);
-  const __m128 cNLo = _mm_and_ps(dMaxPositive, maxStd(zero, _mm_div_ps(nMinZ, dMax)));
+  const __m128 cNLo = _mm_and_ps(dMaxPositive, maxStd(maxStd(zero, _mm_div_ps(nMinZ, dMax)), nLowerCos));
   const __m128 mUpScale = minStd(one, _mm_add_ps(cN, slack));
   // A spot's falloff is not smooth for the first-order estimate (clusterBounds).
   __m128 smooth = type == LightType::Spot ? zero : _mm_cmpgt_ps(cNLo, zero);
   const bool specular = !g.diffuseOnly && sp.hasSpecular();
   __m128 cRUpSlack = zero, cRLo = zero;
   if (specular) {
-    __m128 rMinZ;
-    const __m128 cRUp = cosUpperLanes(pf.r, c, h, rMinZ);
+    __m128 rMinZ, rLowerCos;
+    const __m128 cRUp = cosUpperLanes(pf.r, c, h, rMinZ, rLowerCos);
     cRUpSlack = minStd(one, _mm_add_ps(cRUp, slack));
-    cRLo = _mm_and_ps(_mm_cmpgt_ps(cNLo, zero), maxStd(zero, _mm_div_ps(rMinZ, dMax)));
+    cRLo = _mm_and_ps(_mm_cmpgt_ps(cNLo, zero), maxStd(maxStd(zero, _mm_div_ps(rMinZ, dMax)), rLowerCos));
     smooth = _mm_and_ps(smooth, _mm_cmpgt_ps(cRLo, zero));
   }
   __m128 denMin, denMax;
