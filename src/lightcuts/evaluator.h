@@ -159,4 +159,16 @@ std::unique_ptr<LightEvaluator> makeCourseCuts(const LightSet& lights, const Lig
 std::unique_ptr<LightEvaluator> makeStochasticLightcuts(const LightSet& lights, const LightForest& forest,
                                                         const CutOptions& options);
 
+namespace detail {
+// The visibility coin's rate for each size class of cluster (the log2 of its light count,
+// kCoinSizeClasses of them), from the refinements a cut tested at its point, by class: how
+// many (`tested`) and how many split into a visible and a hidden half (`split`). A class
+// takes the rate of its own refinements, pooled with the next larger classes, then the
+// smaller, until `minRefinements` back it; and at least `floorShare` of the rate over all
+// of them; 0 when there are none (evaluator.cpp, kCoinRateFloor).
+constexpr int kCoinSizeClasses = 24;
+void coinRatesBySize(const uint32_t tested[kCoinSizeClasses], const uint32_t split[kCoinSizeClasses],
+                     uint32_t minRefinements, double floorShare, double rates[kCoinSizeClasses]);
+}  // namespace detail
+
 }  // namespace lc::lightcuts

@@ -27,6 +27,34 @@ struct HalfBlocked : Visibility {
   Color operator()(const Vec3& wi, float) override { return wi.x < 0 ? Color(0) : Color(1); }
 };
 
+// The visibility coin's rates by size class: a class with enough refinements keeps its own
+// rate, one with few pools the larger classes' (then the smaller ones', at the top), and
+// none falls below the floor's share of the rate over all of them.
+TEST(CoinRates, EachSizeClassTakesItsOwnRatePooledWhereItHasFew) {
+  constexpr int n = detail::kCoinSizeClasses;
+  uint32_t tested[n] = {}, split[n] = {};
+  tested[1] = 100, split[1] = 3;  // clusters of 2-3 lights: 3%
+  tested[2] = 100, split[2] = 6;  // 4-7: 6%
+  tested[3] = 10, split[3] = 2;   // 8-15: too few alone
+  tested[4] = 10, split[4] = 4;   // 16-31: too few, and nothing above
+  double rates[n];
+  detail::coinRatesBySize(tested, split, 16, 0.0, rates);
+  EXPECT_DOUBLE_EQ(rates[1], 0.03);
+  EXPECT_DOUBLE_EQ(rates[2], 0.06);
+  EXPECT_DOUBLE_EQ(rates[3], 6.0 / 20);   // with class 4
+  EXPECT_DOUBLE_EQ(rates[4], 6.0 / 20);   // with class 3, below it
+  EXPECT_DOUBLE_EQ(rates[0], 0.03);       // none of its own: class 1's
+  EXPECT_DOUBLE_EQ(rates[10], 6.0 / 20);  // none above: down to class 3
+  // The floor: half the rate over all 220 refinements (15 splits).
+  detail::coinRatesBySize(tested, split, 16, 0.5, rates);
+  EXPECT_DOUBLE_EQ(rates[1], 0.5 * 15 / 220);
+  EXPECT_DOUBLE_EQ(rates[2], 0.06);
+  // No refinements tested: no rate.
+  const uint32_t none[n] = {};
+  detail::coinRatesBySize(none, none, 16, 0.5, rates);
+  for (double r : rates) EXPECT_EQ(r, 0.0);
+}
+
 TEST(BruteForce, SumsEveryLight) {
   LightSet s = cloud(50, LightType::Omni, 1);
   auto bf = makeBruteForce(s);
