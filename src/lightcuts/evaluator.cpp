@@ -90,7 +90,8 @@ constexpr double kSmoothSpreadMin = 0.5;
 // probability 2v(1 - v), so half the point's boundary rate (how often refining split a
 // cluster into a visible and a hidden half) stands for v(1 - v): the rate over the
 // refinements of clusters that are not clear, the only ones this term counts (a clear
-// cluster's children cannot disagree), and of the node's size (kSizeClasses, below). Counted over all refinements, a point whose clear
+// cluster's children cannot disagree), and of the node's size (kSizeClasses, below).
+// Counted over all refinements, a point whose clear
 // clusters were refined hundreds of times priced the few partly hidden ones near zero: a
 // library's ceiling (scripts/gen_library.py) saw a window's small clusters straddle a
 // shelf's edge at a rate of 0.5%, and 1.8% of its pixels were over 2% (0.25% now; the
