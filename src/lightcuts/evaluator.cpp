@@ -130,6 +130,47 @@ constexpr double kCoinRateFloor = 0.5;
 constexpr uint32_t kCoinRatesEvery = 8;
 inline int sizeClass(uint32_t lights) { return std::min(kSizeClasses - 1, int(std::bit_width(lights)) - 1); }
 
+// The coins of a cut's nodes (CutNode::hideable) summed by size class, each class's times
+// its rate at the point (kSizeClasses), kept as nodes come and go. The rates are pooled
+// afresh, in one pass over prefix sums, once the refinements tested have grown by
+// kCoinRatesEvery and by an eighth since the last time: the criterion asks for the sum at
+// every step near the end, and pooling at each of them cost the church a tenth of its
+// cut's instructions.
+class VisibilityCoins {
+ public:
+  // A refinement of a cluster of `lights` that was not clear, and whether its children's
+  // representatives disagreed.
+  void refined(uint32_t lights, bool split) {
+    ++tested_[sizeClass(lights)];
+    split_[sizeClass(lights)] += split;
+  }
+  // A node's coin comes (positive) or goes (negative).
+  void add(uint32_t lights, double hideable) {
+    double& h = hideable_[sizeClass(lights)];
+    const double next = std::max(0.0, h + hideable);
+    sum_ += rate_[sizeClass(lights)] * (next - h);
+    h = next;
+  }
+  // The sum, with the rates as of `refinedTested` refinements tested at the point.
+  double sum(uint32_t refinedTested) {
+    if (!ratesSet_ || refinedTested - ratesAt_ >= std::max(kCoinRatesEvery, ratesAt_ / 8)) {
+      ratesSet_ = true;
+      ratesAt_ = refinedTested;
+      detail::coinRatesBySize(tested_, split_, kCoinMinRefinements, kCoinRateFloor, rate_);
+      sum_ = 0;
+      for (int c = 0; c < kSizeClasses; ++c) sum_ += rate_[c] * hideable_[c];
+    }
+    return sum_;
+  }
+
+ private:
+  double hideable_[kSizeClasses] = {}, rate_[kSizeClasses] = {};
+  uint32_t tested_[kSizeClasses] = {}, split_[kSizeClasses] = {};
+  double sum_ = 0;
+  uint32_t ratesAt_ = 0;
+  bool ratesSet_ = false;
+};
+
 // Second samples (kSecondSampleShare, evaluator.h): a cluster whose representative is
 // visible and whose estimate holds more than that share of the cut's error limit gets a
 // second sample of its visibility before the cut may stop: the representative of its other
@@ -290,7 +331,7 @@ class Lightcuts final : public LightEvaluator {
     bool scaled;      // its spread is scaled by the boundary rate (kSmoothSpreadPerBoundary)
     bool clear;       // no surface can hide any of its lights (Visibility::boxClear)
     float hideable;   // its coin: the luminance squared of its estimate (visible) or of its
-                      // unshadowed estimate (hidden), in hideableBySize
+                      // unshadowed estimate (hidden), in VisibilityCoins
     uint32_t blocker;  // the hint for its boxClear test
     int32_t exact;     // untested and small: its index in `exacts` once its U is known, else -1
     bool sampledTwice = false;  // given its second sample (kSecondSampleShare)
@@ -386,41 +427,12 @@ class Lightcuts final : public LightEvaluator {
     Vec3d total;
     uint32_t cutSize = 0;
     // Sums of the squared spreads of the nodes in the heap: those scaled by the boundary
-    // rate, and the others; and of their coins (CutNode::hideable, kHiddenSharePerBoundary)
-    // by size class (kSizeClasses).
+    // rate, and the others; and their coins (kHiddenSharePerBoundary).
     double sumSq = 0, sumScaled = 0;
-    double hideableBySize[kSizeClasses] = {};
-    // The boundary rate's counts, and those of the refinements of clusters that were not
-    // clear (whose children can disagree: kHiddenSharePerBoundary) by size class.
+    VisibilityCoins coins;
+    // The boundary rate's counts (the coins count the refinements of clusters that were not
+    // clear, whose children can disagree, by size).
     uint32_t refinedTested = 0, refinedSplit = 0;
-    uint32_t coinTested[kSizeClasses] = {}, coinSplit[kSizeClasses] = {};
-    // The coins' sum, each size class's by its rate (kSizeClasses), kept as the classes'
-    // sums change. The rates are pooled afresh, in one pass over prefix sums, once the
-    // refinements tested have grown by kCoinRatesEvery and by an eighth since the last time:
-    // the criterion is asked for at every step near the end, and pooling at each of them
-    // cost the church a tenth of its cut's instructions.
-    double coinRate[kSizeClasses] = {};
-    double coin = 0;
-    uint32_t ratesAt = 0;
-    bool ratesSet = false;
-    auto addHideable = [&](int c, double delta) {
-      double& h = hideableBySize[c];
-      const double next = std::max(0.0, h + delta);
-      coin += coinRate[c] * (next - h);
-      h = next;
-    };
-    auto dropHideable = [&](const CutNode& cn) { addHideable(sizeClass(cn.lights), -double(cn.hideable)); };
-    auto refreshRates = [&] {
-      ratesSet = true;
-      ratesAt = refinedTested;
-      detail::coinRatesBySize(coinTested, coinSplit, kCoinMinRefinements, kCoinRateFloor, coinRate);
-      coin = 0;
-      for (int c = 0; c < kSizeClasses; ++c) coin += coinRate[c] * hideableBySize[c];
-    };
-    auto coinSum = [&] {
-      if (!ratesSet || refinedTested - ratesAt >= std::max(kCoinRatesEvery, ratesAt / 8)) refreshRates();
-      return coin;
-    };
     const bool rss = opt_.criterion == CutCriterion::Total;
     const bool firstOrder = opt_.estimator == Estimator::FirstOrder;
     const bool probes = opt_.visibilityProbes;
@@ -519,7 +531,7 @@ class Lightcuts final : public LightEvaluator {
           else if (found == CutVisibility::Occluded) le = shadow.unshadowed * luminance(n.intensity);
         }
         const float hideable = le * le;
-        addHideable(sizeClass(n.lights()), hideable);
+        coins.add(n.lights(), hideable);
         // The heap orders nodes by what their estimates may be off by: a clear cluster's
         // estimate and its light both lie within its lower and upper bounds, so its spread;
         // any other's by its upper bound (it may be partly hidden, whatever its
@@ -560,7 +572,7 @@ class Lightcuts final : public LightEvaluator {
         ++stats.secondSamplesHidden;
         double& sum = cn.scaled ? sumScaled : sumSq;
         sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
-        dropHideable(cn);
+        coins.add(cn.lights, -double(cn.hideable));
         cn.hideable = 0;
         cn.scaled = false;
         cn.spread = cn.upper;
@@ -597,7 +609,7 @@ class Lightcuts final : public LightEvaluator {
         const double rate = double(refinedSplit) / std::max(1u, refinedTested);
         const double w = std::clamp(kSmoothSpreadPerBoundary * rate, kSmoothSpreadMin, 1.0);
         auto holds = [&] {
-          return sumSq + w * w * sumScaled + kHiddenSharePerBoundary * coinSum() <= rssFactor2 * double(limit) * limit;
+          return sumSq + w * w * sumScaled + kHiddenSharePerBoundary * coins.sum(refinedTested) <= rssFactor2 * double(limit) * limit;
         };
         if (holds() && !(opt_.secondSamples && secondSamples(limit) && !holds())) break;
       }
@@ -625,7 +637,7 @@ class Lightcuts final : public LightEvaluator {
       const CutNode cn = popped;
       double& sum = cn.scaled ? sumScaled : sumSq;
       sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
-      dropHideable(cn);
+      coins.add(cn.lights, -double(cn.hideable));
       const LightTree& tree = forest_.trees[cn.tree];
       if (probes && cn.shadow.blocker >= 0 && cn.lights >= kProbeMinLights &&
           hiddenCluster(tree.nodes[cn.node], tree.type, sp, cn.shadow, vis, stats)) {
@@ -673,10 +685,7 @@ class Lightcuts final : public LightEvaluator {
         boundary = hidden(shadows[0].found) != hidden(shadows[1].found);
         ++refinedTested;
         refinedSplit += boundary;
-        if (!cnClear) {
-          ++coinTested[sizeClass(cn.lights)];
-          coinSplit[sizeClass(cn.lights)] += boundary;
-        }
+        if (!cnClear) coins.refined(cn.lights, boundary);
       }
       // Two inner children are bounded together (bounds_pair.h): the same bounds bit for
       // bit, and the cut loop 7-9% faster (docs/BENCHMARKS.md).
