@@ -43,18 +43,6 @@ inline float cosBoundBox(const Frame& f, const Vec3& lo, const Vec3& hi) {
   return std::min(1.0f, mz / std::sqrt(x2 + y2 + mz * mz));
 }
 
-// Lower bound of cos(angle(f.w, q)) over the box of vectors [lo, hi], or 0 when some
-// vector may be at 90 degrees or more: min z / max |q| after the same rotation.
-inline float cosLowerBoundBox(const Frame& f, const Vec3& lo, const Vec3& hi) {
-  Vec3 c = (lo + hi) * 0.5f, h = (hi - lo) * 0.5f;
-  float hz = dot(f.aw, h), cz = dot(c, f.w);
-  float minZ = cz - hz;
-  if (minZ <= 0) return 0;
-  float ax = std::fabs(dot(c, f.u)) + dot(f.au, h), ay = std::fabs(dot(c, f.v)) + dot(f.av, h);
-  float maxZ = cz + hz;
-  return minZ / std::sqrt(ax * ax + ay * ay + maxZ * maxZ);
-}
-
 // Narrows a cosine lower bound by a cone of half-angle beta: cos(theta + beta), 0 past 90.
 inline float coneNarrow(float cosTheta, float cosBeta, float sinBeta) {
   if (cosBeta <= 0 || cosTheta <= 0) return 0;
@@ -95,18 +83,11 @@ struct RotatedBox {
   // 0 when some vector may be at 90 degrees or more. Tighter than the smallest z over the
   // longest vector when the box is seen nearly head-on: a box of 1 straight above a point 3
   // away, 0.96 rather than 0.70 (clusterBounds takes the larger of the two).
-  float nearLowerCos() const {
+  float cosLower() const {
     float minZ = cz - hz;
     if (minZ <= 0) return 0;
     float bx = std::fabs(cx) + hx, by = std::fabs(cy) + hy;
     return minZ / std::sqrt(bx * bx + by * by + minZ * minZ);
-  }
-  // Lower bound (as cosLowerBoundBox); 0 when some vector may be at 90 degrees or more.
-  float cosLower() const {
-    float minZ = cz - hz;
-    if (minZ <= 0) return 0;
-    float ax = std::fabs(cx) + hx, ay = std::fabs(cy) + hy, maxZ = cz + hz;
-    return minZ / std::sqrt(ax * ax + ay * ay + maxZ * maxZ);
   }
 };
 
@@ -184,10 +165,10 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
   float dMax = length(vmax(vabs(lo), vabs(hi)));
   float dMin = std::sqrt(dot(vmax(vmax(lo, -hi), Vec3(0.0f)), vmax(vmax(lo, -hi), Vec3(0.0f))));
   // Lower cosine bounds: the smallest projection over the longest vector, or over the
-  // longest the nearest projection can come with (RotatedBox::nearLowerCos), the larger.
+  // longest the nearest projection can come with (RotatedBox::cosLower), the larger.
   // Lights that may be behind the surface give nothing at all, so no lower bound then
   // (specular neither).
-  float cNLo = lower && dMax > 0 ? std::max(std::max(0.0f, (bn.cz - bn.hz) / dMax), bn.nearLowerCos()) : 0.0f;
+  float cNLo = lower && dMax > 0 ? std::max(std::max(0.0f, (bn.cz - bn.hz) / dMax), bn.cosLower()) : 0.0f;
   if (lower && directional) cNLo = std::max(cNLo, un.lo);
   bool specular = !g.diffuseOnly && sp.hasSpecular();
   Color mUp = sp.kd * std::min(1.0f, cN + kCosSlack);
@@ -205,7 +186,7 @@ inline Color clusterBounds(const LightNode& node, LightType type, const LightGro
       cRUp = std::max(0.0f, std::min(cRUp, ur.up));
     }
     mUp += sp.ks * powNonNegative(std::min(1.0f, cRUp + kCosSlack), sp.shininess);
-    float cRLo = cNLo > 0 ? std::max(std::max(0.0f, (br.cz - br.hz) / dMax), br.nearLowerCos()) : 0.0f;
+    float cRLo = cNLo > 0 ? std::max(std::max(0.0f, (br.cz - br.hz) / dMax), br.cosLower()) : 0.0f;
     if (cNLo > 0 && directional) cRLo = std::max(cRLo, ur.lo);
     if (cNLo > 0) mLo += sp.ks * powNonNegative(cRLo, sp.shininess);
     sm = sm && cRLo > 0;

@@ -67,7 +67,7 @@ struct FrameLanes {
 };
 
 // RotatedBox(f, c, h).cosUpper(), its cz - hz (the lower bounds' numerator) and its
-// nearLowerCos() (0 where cz - hz <= 0).
+// cosLower() (0 where cz - hz <= 0).
 inline __m128 cosUpperLanes(const FrameLanes& f, const Lanes3& c, const Lanes3& h, __m128& minZ, __m128& lowerCos) {
   const __m128 zero = _mm_setzero_ps();
   const __m128 cx = dot(c, f.u), hx = dot(f.au, h);

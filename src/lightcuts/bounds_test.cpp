@@ -65,18 +65,18 @@ TEST(CosBoundBox, IsTightForAPointOnTheAxis) {
   EXPECT_NEAR(cosBoundBox(f, Vec3(1, 0, 1), Vec3(1, 0, 1)), std::sqrt(0.5f), 1e-6f);
 }
 
-// The lower cosine from the box's nearest projection (RotatedBox::nearLowerCos) holds at
+// The lower cosine from the box's nearest projection (RotatedBox::cosLower) holds at
 // every point of the box, in any frame, and is the exact least cosine for a box seen
 // head-on: 0.96 for a unit cube 2.5 to 3.5 above the point, where the smallest projection
 // over the longest vector gives 0.70 (and the cube's corners are at 0.962).
-TEST(RotatedBox, NearLowerCosBoundsSampledDirections) {
+TEST(RotatedBox, CosLowerBoundsSampledDirections) {
   Rng r(4, 4);
   int positive = 0;
   for (int i = 0; i < 5000; ++i) {
     Vec3 lo(4 * r.uniform() - 2, 4 * r.uniform() - 2, 4 * r.uniform() - 2);
     Vec3 hi = lo + Vec3(r.uniform(), r.uniform(), r.uniform()) * 2;
     Frame f = makeFrame(randomUnit(r));
-    const float b = RotatedBox(f, (lo + hi) * 0.5f, (hi - lo) * 0.5f).nearLowerCos();
+    const float b = RotatedBox(f, (lo + hi) * 0.5f, (hi - lo) * 0.5f).cosLower();
     if (!(b > 0)) continue;  // 0: some direction may be at 90 degrees or more
     ++positive;
     for (int k = 0; k < 50; ++k) {
@@ -89,7 +89,7 @@ TEST(RotatedBox, NearLowerCosBoundsSampledDirections) {
   const Frame up = makeFrame(Vec3(0, 1, 0));
   const RotatedBox cube(up, Vec3(0, 3, 0), Vec3(0.5f));
   const float corner = 2.5f / std::sqrt(2.5f * 2.5f + 0.5f);
-  EXPECT_NEAR(cube.nearLowerCos(), corner, 1e-6f);
+  EXPECT_NEAR(cube.cosLower(), corner, 1e-6f);
   EXPECT_LT(2.5f / length(Vec3(0.5f, 3.5f, 0.5f)), 0.71f);
 }
 

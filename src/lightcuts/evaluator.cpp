@@ -132,7 +132,7 @@ inline int sizeClass(uint32_t lights) { return std::min(kSizeClasses - 1, int(st
 
 // The coins of a cut's nodes (CutNode::hideable) summed by size class, each class's times
 // its rate at the point (kSizeClasses), kept as nodes come and go. The rates are pooled
-// afresh, in one pass over prefix sums, once the refinements tested have grown by
+// afresh, in one pass over prefix sums, once the refinements counted have grown by
 // kCoinRatesEvery and by an eighth since the last time: the criterion asks for the sum at
 // every step near the end, and pooling at each of them cost the church a tenth of its
 // cut's instructions.
@@ -141,21 +141,21 @@ class VisibilityCoins {
   // A refinement of a cluster of `lights` that was not clear, and whether its children's
   // representatives disagreed.
   void refined(uint32_t lights, bool split) {
-    ++tested_[sizeClass(lights)];
-    split_[sizeClass(lights)] += split;
+    const int c = sizeClass(lights);
+    ++tested_[c];
+    split_[c] += split;
+    ++refinements_;
   }
   // A node's coin comes (positive) or goes (negative).
   void add(uint32_t lights, double hideable) {
-    double& h = hideable_[sizeClass(lights)];
-    const double next = std::max(0.0, h + hideable);
-    sum_ += rate_[sizeClass(lights)] * (next - h);
-    h = next;
+    const int c = sizeClass(lights);
+    const double next = std::max(0.0, hideable_[c] + hideable);
+    sum_ += rate_[c] * (next - hideable_[c]);
+    hideable_[c] = next;
   }
-  // The sum, with the rates as of `refinedTested` refinements tested at the point.
-  double sum(uint32_t refinedTested) {
-    if (!ratesSet_ || refinedTested - ratesAt_ >= std::max(kCoinRatesEvery, ratesAt_ / 8)) {
-      ratesSet_ = true;
-      ratesAt_ = refinedTested;
+  double sum() {
+    if (refinements_ >= nextRates_) {
+      nextRates_ = refinements_ + std::max(kCoinRatesEvery, refinements_ / 8);
       detail::coinRatesBySize(tested_, split_, kCoinMinRefinements, kCoinRateFloor, rate_);
       sum_ = 0;
       for (int c = 0; c < kSizeClasses; ++c) sum_ += rate_[c] * hideable_[c];
@@ -167,8 +167,7 @@ class VisibilityCoins {
   double hideable_[kSizeClasses] = {}, rate_[kSizeClasses] = {};
   uint32_t tested_[kSizeClasses] = {}, split_[kSizeClasses] = {};
   double sum_ = 0;
-  uint32_t ratesAt_ = 0;
-  bool ratesSet_ = false;
+  uint32_t refinements_ = 0, nextRates_ = 0;  // refinements counted; when to pool again
 };
 
 // Second samples (kSecondSampleShare, evaluator.h): a cluster whose representative is
@@ -609,7 +608,8 @@ class Lightcuts final : public LightEvaluator {
         const double rate = double(refinedSplit) / std::max(1u, refinedTested);
         const double w = std::clamp(kSmoothSpreadPerBoundary * rate, kSmoothSpreadMin, 1.0);
         auto holds = [&] {
-          return sumSq + w * w * sumScaled + kHiddenSharePerBoundary * coins.sum(refinedTested) <= rssFactor2 * double(limit) * limit;
+          return sumSq + w * w * sumScaled + kHiddenSharePerBoundary * coins.sum() <=
+                 rssFactor2 * double(limit) * limit;
         };
         if (holds() && !(opt_.secondSamples && secondSamples(limit) && !holds())) break;
       }
