@@ -324,6 +324,9 @@ void printRenderSummary(const RenderReport& r) {
     fmt::print("mpi        {} ranks x {} thread{}: tiles {}, busy {} s; load balance {:.0f}%\n", r.ranks,
                threads, threads == 1 ? "" : "s", tiles, busy, 100 * r.loadBalance);
   }
+  if (ro.reconstructSpacing == 1)
+    fmt::print("recon.     full lightcuts at every pixel centre; {} sub-samples rebuilt from them, {} got full cuts\n",
+               formatCount(double(es.reconstructedPoints)), formatCount(double(rr.stats.reconstructionFallbacks)));
   if (ro.reconstructSpacing > 1)
     fmt::print("recon.     full lightcuts every {} pixels ({} samples{}{}); {} points rebuilt from them, {} got full cuts\n",
                ro.reconstructSpacing, formatCount(double(rr.stats.reconstructionSamples)),

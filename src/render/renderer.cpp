@@ -103,7 +103,7 @@ constexpr int64_t kMinTiles = 16;
 
 TileGrid tileGrid(const RenderOptions& o, const LightEvaluator& evaluator) {
   const int S = o.reconstructSpacing;
-  const bool recon = S > 1 && evaluator.supportsReconstruction();
+  const bool recon = S >= 1 && evaluator.supportsReconstruction();
   const int C = std::max(S, o.reconstructCoarseSpacing);
   TileGrid g;
   g.width = o.width;
@@ -155,7 +155,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   // last row and column). Tiles are whole cells wide so a tile needs only the samples on
   // its cells' corners; those on its right and bottom edges are shared with the next
   // tiles (EdgeSamples).
-  const bool recon = o.reconstructSpacing > 1 && evaluator.supportsReconstruction();
+  const bool recon = o.reconstructSpacing >= 1 && evaluator.supportsReconstruction();
   const TileGrid grid = tileGrid(o, evaluator);
   std::optional<ReconstructionRender> reconstruction;
   if (recon) reconstruction.emplace(scene, evaluator, o, grid.tile);

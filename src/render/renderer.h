@@ -95,7 +95,9 @@ struct RenderOptions {
   int referencePixels = 0;
   // Reconstruction cuts (lightcuts only; lightcuts/reconstruction.h): a full lightcut at
   // every Nth pixel in x and y, the primary hits in between rebuilt from the four around
-  // them when they lie on the same surface. 0 or 1 = a full lightcut everywhere.
+  // them when they lie on the same surface. 0 = a full lightcut everywhere; 1 = a full
+  // lightcut at every pixel centre, the pixel's other points (antialiasing's sub-samples,
+  // spp's samples) rebuilt from the centres around them.
   int reconstructSpacing = 0;
   // Larger cells first (a multiple of reconstructSpacing by a power of two; 0 = none): a
   // cell of this size is rebuilt from its four corner samples when they lie on one surface
