@@ -67,9 +67,10 @@ double cameraHitFraction(const scene::Scene& scene) {
 // 4 sampled the same shadows more densely than they need (docs/LIGHTCUTS.md).
 // Below that size a full cut at every point, sub-samples included: rebuilding only the
 // sub-samples from the pixel centres (--reconstruct 1) made the 100,000-light room at 64 x
-// 64 1.75x faster at the same error, but put 0.4-1.7% of pixels over 2% on unseen scenes of
+// 64 1.5x faster at the same error, but put 0.4-1.7% of pixels over 2% on unseen scenes of
 // fine geometry at 128 x 128 (a library's shelves, a theatre's seats behind a railing),
-// against 0.01-0.34% (docs/LIGHTCUTS.md, "Sub-samples rebuilt from pixel centres").
+// against 0.01-0.34%, and 0.2-0.8% at 256 x 256 against 0-0.22% (docs/LIGHTCUTS.md,
+// "Sub-samples rebuilt from pixel centres").
 constexpr int kAutoReconstructSpacing = 4;
 constexpr int kAutoReconstructMinSide = 512;  // from kAutoReconstructMinSide^2 pixels up
 int reconstructSpacing(const std::string& option, int width, int height) {
