@@ -91,18 +91,18 @@ constexpr double kSmoothSpreadMin = 0.5;
 // cluster into a visible and a hidden half) stands for v(1 - v): the rate over the
 // refinements of clusters that are not clear, the only ones this term counts (a clear
 // cluster's children cannot disagree), and of the node's size (kSizeClasses, below).
-// Counted over all refinements, a point whose clear
-// clusters were refined hundreds of times priced the few partly hidden ones near zero: a
-// library's ceiling (scripts/gen_library.py) saw a window's small clusters straddle a
-// shelf's edge at a rate of 0.5%, and 1.8% of its pixels were over 2% (0.25% now; the
-// 100k-light room pays 17% more rays, the interiors of the benchmark nothing: their clear
-// clusters are few; docs/LIGHTCUTS.md, "The coin's rate"). A visible node whose
-// sibling agreed with it adds, in square, its estimate squared times that, and so does a
-// hidden node its unshadowed estimate (as well as its upper bound), scaled so
-// that the criterion's 1.6 (kTotalFactor) root-sum-square holds 2.576 standard deviations,
-// where 99% of a normal error lies: (1.6 x 2.576)^2 / 2 = 8.5. (It was 4, chosen on random
-// rooms; a lattice, scripts/gen_pergola.py, whose clusters are all partly hidden, kept 1.8%
-// of pixels over 2% with full cuts. docs/LIGHTCUTS.md, "One coin for both sides".)
+// Counted over all refinements, a point whose clear clusters were refined hundreds of times
+// priced the few partly hidden ones near zero: a library's ceiling (scripts/gen_library.py)
+// saw a window's small clusters straddle a shelf's edge at a rate of 0.5%, and 1.8% of its
+// pixels were over 2% (0.25% now; the 100k-light room pays 17% more rays, the interiors of
+// the benchmark nothing: their clear clusters are few; docs/LIGHTCUTS.md, "The coin's
+// rate"). A visible node whose sibling agreed with it adds, in square, its estimate squared
+// times that, and so does a hidden node its unshadowed estimate (as well as its upper
+// bound), scaled so that the criterion's 1.6 (kTotalFactor) root-sum-square holds 2.576
+// standard deviations, where 99% of a normal error lies: (1.6 x 2.576)^2 / 2 = 8.5. (It was
+// 4, chosen on random rooms; a lattice, scripts/gen_pergola.py, whose clusters are all
+// partly hidden, kept 1.8% of pixels over 2% with full cuts. docs/LIGHTCUTS.md, "One coin
+// for both sides".)
 constexpr double kVisibilityConfidence = 2.576;
 constexpr double kHiddenSharePerBoundary =
     kTotalFactor * kVisibilityConfidence * kTotalFactor * kVisibilityConfidence / 2;

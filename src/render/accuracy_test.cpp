@@ -5,6 +5,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <utility>
 
 #include "io/image_metrics.h"
 #include "io/ray_parser.h"
@@ -555,21 +556,23 @@ TEST(Determinism, ReconstructionCutsImageIsTheSameAtOneAndTwoThreads) {
   Loaded l = loadCornell();
   lightcuts::LightForest forest = lightcuts::buildLightForest(l.scene->lights());
   auto lc = lightcuts::makeLightcuts(l.scene->lights(), forest, lightcuts::CutOptions{});
-  // Spacing 1: a full cut at every pixel centre, the other points rebuilt from them.
+  // (spacing, coarse cells); spacing 1: a full cut at every pixel centre, the other
+  // points rebuilt from them.
+  const std::pair<int, int> grids[] = {{4, 0}, {4, 8}, {1, 0}};
   for (int spp : {1, 2})
-    for (int coarse : {0, 8, -1}) {
+    for (const auto& [spacing, coarse] : grids) {
       RenderOptions o;
       o.width = 70;  // not a multiple of the spacing or the tile: partial cells and tiles
       o.height = 45;
       o.spp = spp;
-      o.reconstructSpacing = coarse < 0 ? 1 : 4;
-      o.reconstructCoarseSpacing = std::max(coarse, 0);
+      o.reconstructSpacing = spacing;
+      o.reconstructCoarseSpacing = coarse;
       o.threads = 1;
       RenderResult a = render(*l.scene, *lc, o);
       o.threads = 2;
       RenderResult b = render(*l.scene, *lc, o);
       for (size_t i = 0; i < a.image.pixels.size(); ++i)
-        ASSERT_EQ(a.image.pixels[i], b.image.pixels[i]) << spp << " " << coarse << " " << i;
+        ASSERT_EQ(a.image.pixels[i], b.image.pixels[i]) << spp << " " << spacing << " " << coarse << " " << i;
       for (uint8_t d : a.done) ASSERT_EQ(d, 1);
       EXPECT_EQ(a.stats.reconstructionCoarseCells, b.stats.reconstructionCoarseCells);
     }

@@ -101,9 +101,17 @@ constexpr int kReconstructionTile = 64;
 // enough to keep every thread of a small machine busy to the end.
 constexpr int64_t kMinTiles = 16;
 
+namespace {
+// Whether the render takes reconstruction cuts: a spacing of 1 or more, and an evaluator
+// that records cuts (lightcuts).
+bool reconstructs(const RenderOptions& o, const LightEvaluator& evaluator) {
+  return o.reconstructSpacing >= 1 && evaluator.supportsReconstruction();
+}
+}  // namespace
+
 TileGrid tileGrid(const RenderOptions& o, const LightEvaluator& evaluator) {
   const int S = o.reconstructSpacing;
-  const bool recon = S >= 1 && evaluator.supportsReconstruction();
+  const bool recon = reconstructs(o, evaluator);
   const int C = std::max(S, o.reconstructCoarseSpacing);
   TileGrid g;
   g.width = o.width;
@@ -155,7 +163,7 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   // last row and column). Tiles are whole cells wide so a tile needs only the samples on
   // its cells' corners; those on its right and bottom edges are shared with the next
   // tiles (EdgeSamples).
-  const bool recon = o.reconstructSpacing >= 1 && evaluator.supportsReconstruction();
+  const bool recon = reconstructs(o, evaluator);
   const TileGrid grid = tileGrid(o, evaluator);
   std::optional<ReconstructionRender> reconstruction;
   if (recon) reconstruction.emplace(scene, evaluator, o, grid.tile);
