@@ -76,8 +76,7 @@ inline Float4 pow4(Float4 x, float y) {
 }  // namespace
 
 void MergedBatch::clear() {
-  for (auto* v : {&px, &py, &pz, &nx, &ny, &nz, &ir, &ig, &ib, &attA, &attB, &attC, &attMax, &oriented, &specular})
-    v->clear();
+  blocks.clear();
   count = 0;
   anySpecular = false;
 }
@@ -86,26 +85,27 @@ void MergedBatch::add(const Light& rep, const LightGroup& g, const Color& intens
   const size_t block = count / 4, lane = count % 4;
   if (lane == 0) {
     // A new block, its lanes harmless until filled: lights at the origin of zero intensity.
-    for (auto* v : {&px, &py, &pz, &nx, &ny, &nz, &ir, &ig, &ib, &attA, &attB, &attC, &oriented, &specular})
-      v->push_back(splat(0));
-    attMax.push_back(splat(kInf));
+    Block empty{};
+    empty.attMax = splat(kInf);
+    blocks.push_back(empty);
   }
+  Block& b = blocks[block];
   const bool o = rep.type == LightType::Oriented;
-  px[block][lane] = rep.position.x;
-  py[block][lane] = rep.position.y;
-  pz[block][lane] = rep.position.z;
-  nx[block][lane] = o ? rep.direction.x : 0.0f;
-  ny[block][lane] = o ? rep.direction.y : 0.0f;
-  nz[block][lane] = o ? rep.direction.z : 0.0f;
-  ir[block][lane] = intensity.x;
-  ig[block][lane] = intensity.y;
-  ib[block][lane] = intensity.z;
-  attA[block][lane] = g.atten.constant;
-  attB[block][lane] = g.atten.linear;
-  attC[block][lane] = g.atten.quadratic;
-  attMax[block][lane] = g.atten.maxDistance;
-  oriented[block][lane] = o ? 1.0f : 0.0f;
-  specular[block][lane] = g.diffuseOnly ? 0.0f : 1.0f;
+  b.px[lane] = rep.position.x;
+  b.py[lane] = rep.position.y;
+  b.pz[lane] = rep.position.z;
+  b.nx[lane] = o ? rep.direction.x : 0.0f;
+  b.ny[lane] = o ? rep.direction.y : 0.0f;
+  b.nz[lane] = o ? rep.direction.z : 0.0f;
+  b.ir[lane] = intensity.x;
+  b.ig[lane] = intensity.y;
+  b.ib[lane] = intensity.z;
+  b.attA[lane] = g.atten.constant;
+  b.attB[lane] = g.atten.linear;
+  b.attC[lane] = g.atten.quadratic;
+  b.attMax[lane] = g.atten.maxDistance;
+  b.oriented[lane] = o ? 1.0f : 0.0f;
+  b.specular[lane] = g.diffuseOnly ? 0.0f : 1.0f;
   anySpecular |= !g.diffuseOnly;
   ++count;
 }
@@ -119,30 +119,31 @@ Color evaluateBatch(const MergedBatch& b, const ShadingPoint& sp, size_t firstBl
   // giving ks wherever the light reaches.
   const bool specular = sp.hasSpecular() && b.anySpecular;
   Float4 dr = zero, dg = zero, db = zero, sr = zero, sg = zero, sb = zero;
-  endBlock = std::min(endBlock, b.px.size());
+  endBlock = std::min(endBlock, b.blocks.size());
   for (size_t k = firstBlock; k < endBlock; ++k) {
-    const Float4 o = b.oriented[k];
-    const Float4 dx = b.px[k] - Px, dy = b.py[k] - Py, dz = b.pz[k] - Pz;
+    const MergedBatch::Block& B = b.blocks[k];
+    const Float4 o = B.oriented;
+    const Float4 dx = B.px - Px, dy = B.py - Py, dz = B.pz - Pz;
     const Float4 d2 = dx * dx + dy * dy + dz * dz;
     const Float4 inv = one / sqrt4(select(d2 > zero, d2, one));
     const Float4 dist = d2 * inv;
     const Float4 wx = dx * inv, wy = dy * inv, wz = dz * inv;
-    const Float4 den = b.attA[k] + dist * (b.attB[k] + dist * b.attC[k]);
-    const Float4 A = select(dist > b.attMax[k], zero, select(den <= one, one, one / select(den <= one, one, den)));
-    const Float4 cL = o * -(b.nx[k] * wx + b.ny[k] * wy + b.nz[k] * wz) + (one - o);
+    const Float4 den = B.attA + dist * (B.attB + dist * B.attC);
+    const Float4 A = select(dist > B.attMax, zero, select(den <= one, one, one / select(den <= one, one, den)));
+    const Float4 cL = o * -(B.nx * wx + B.ny * wy + B.nz * wz) + (one - o);
     const Float4 cN = Nx * wx + Ny * wy + Nz * wz;
     const Mask4 lit = (d2 > zero) & (cN > zero) & (cL > zero) & (A > zero);
     const Float4 G = select(lit, cL * A, zero);
     const Float4 vd = cN * G;
-    dr += vd * b.ir[k];
-    dg += vd * b.ig[k];
-    db += vd * b.ib[k];
+    dr += vd * B.ir;
+    dg += vd * B.ig;
+    db += vd * B.ib;
     if (specular) {
       const Float4 cR = Rx * wx + Ry * wy + Rz * wz;
-      const Float4 vs = b.specular[k] * pow4(select(cR > zero, cR, zero), sp.shininess) * G;
-      sr += vs * b.ir[k];
-      sg += vs * b.ig[k];
-      sb += vs * b.ib[k];
+      const Float4 vs = B.specular * pow4(select(cR > zero, cR, zero), sp.shininess) * G;
+      sr += vs * B.ir;
+      sg += vs * B.ig;
+      sb += vs * B.ib;
     }
   }
   auto sum = [](Float4 v) { return (v[0] + v[1]) + (v[2] + v[3]); };

@@ -16,14 +16,18 @@ namespace lc::lightcuts {
 using Float4 = float __attribute__((vector_size(16)));
 
 struct MergedBatch {
-  // Node i is lane i % 4 of block i / 4 in every array; the last block is padded with
-  // nodes of zero intensity.
-  std::vector<Float4> px, py, pz;  // representative's position
-  std::vector<Float4> nx, ny, nz;  // its normal (oriented lights); 0 for omni lights
-  std::vector<Float4> ir, ig, ib;  // the node's intensity (times its first-order factor)
-  std::vector<Float4> attA, attB, attC, attMax;  // attenuation min(1, 1/(a + b d + c d^2)), 0 beyond max
-  std::vector<Float4> oriented;    // 1: the light's cosine applies; 0: omni
-  std::vector<Float4> specular;    // 1: the group lights the specular term (not diffuseOnly)
+  // Four nodes: node i is lane i % 4 of block i / 4; the last block is padded with nodes of
+  // zero intensity. One block is one push per four nodes and 240 contiguous bytes (as
+  // fifteen arrays of lanes, their pushes made add() 1.6x dearer: callgrind, 300k VPLs).
+  struct Block {
+    Float4 px, py, pz;           // representative's position
+    Float4 nx, ny, nz;           // its normal (oriented lights); 0 for omni lights
+    Float4 ir, ig, ib;           // the node's intensity (times its first-order factor)
+    Float4 attA, attB, attC, attMax;  // attenuation min(1, 1/(a + b d + c d^2)), 0 beyond max
+    Float4 oriented;             // 1: the light's cosine applies; 0: omni
+    Float4 specular;             // 1: the group lights the specular term (not diffuseOnly)
+  };
+  std::vector<Block> blocks;
   size_t count = 0;
   bool anySpecular = false;
 

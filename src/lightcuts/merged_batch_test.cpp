@@ -47,7 +47,7 @@ TEST(MergedBatch, EqualsThePerNodePath) {
     Color got = evaluateBatch(b, sp);
     // And block by block.
     Color parts(0);
-    for (size_t k = 0; k < b.px.size(); ++k) parts += evaluateBatch(b, sp, k, k + 1);
+    for (size_t k = 0; k < b.blocks.size(); ++k) parts += evaluateBatch(b, sp, k, k + 1);
     for (int c = 0; c < 3; ++c) ASSERT_NEAR(parts[c], got[c], 1e-5f * (std::fabs(got[c]) + 1e-3f));
     for (int c = 0; c < 3; ++c)
       ASSERT_NEAR(got[c], want[c], 2e-5f * (std::fabs(want[c]) + 1e-3f)) << "trial " << trial << " channel " << c;
@@ -60,7 +60,7 @@ TEST(MergedBatch, EmptyBatchGivesNothing) {
   b.add(Light{}, LightGroup{}, Color(1));
   b.clear();
   EXPECT_EQ(b.count, 0u);
-  EXPECT_TRUE(b.px.empty());
+  EXPECT_TRUE(b.blocks.empty());
 }
 
 }  // namespace
