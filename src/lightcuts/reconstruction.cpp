@@ -1,6 +1,7 @@
 #include "lightcuts/reconstruction.h"
 
 #include <algorithm>
+#include <bit>
 
 #include "lightcuts/exact_sum.h"
 
@@ -101,7 +102,13 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
     // Per sample with a state (not kAbove): the preorder position where the entry that gave
     // it ends (the first past its subtree).
     uint32_t coverEnd[kMaxSamples];
+    // Per sample: its entries and their nodes (held here: read through the records at every
+    // step, the pointers were loaded again after each store to the output).
+    const uint32_t* entries[kMaxSamples];
+    const NodeRef* entryNodes[kMaxSamples];
     for (int i = 0; i < count; ++i) {
+      entries[i] = samples[i]->entries.data();
+      entryNodes[i] = samples[i]->nodes.data();
       cursor[i] = samples[i]->treeBegin[t];
       end[i] = samples[i]->treeBegin[t + 1];
       coverEnd[i] = 0;
@@ -119,7 +126,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
           if (coverEnd[i] > pos) continue;
           setState(state, i, kAbove);
         }
-        const uint32_t* e = samples[i]->entries.data();
+        const uint32_t* e = entries[i];
         uint32_t c = cursor[i];
         while (c < end[i] && CutRecord::preorderOf(e[c]) < pos) ++c;  // skips entries under a coarser cut kept
         cursor[i] = c;
@@ -133,11 +140,11 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
           // The node a few entries on, fetched by the first sample that holds this one
           // (the samples' cuts are mostly the same nodes).
           if (exact == 0 && c + kAhead < end[i]) {
-            const NodeRef ahead = samples[i]->nodes[c + kAhead];
+            const NodeRef ahead = entryNodes[i][c + kAhead];
             __builtin_prefetch(isLeafRef(ahead) ? static_cast<const void*>(&lights.lights[leafLight(ahead)])
                                                 : static_cast<const void*>(&tree.nodes[ahead]));
           }
-          node = samples[i]->nodes[c];
+          node = entryNodes[i][c];
           setState(state, i, uint8_t(uint8_t(CutRecord::visibilityOf(e[c])) |
                                      (CutRecord::firstOrderOf(e[c]) ? kFirstOrderBit : 0)));
           exact |= 1u << i;
@@ -189,7 +196,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         ok = ok && kept && distance2Box(*inner, samples[0]->point) >= kCoarsenRatio2 * spread2;
         for (int i = 0; i < count && ok; ++i) {
           if (stateOf(state, i) != kAbove) continue;
-          const uint32_t* e = samples[i]->entries.data();
+          const uint32_t* e = entries[i];
           past[i] = uint32_t(std::lower_bound(e + cursor[i], e + end[i], nodeEnd,
                                               [](uint32_t en, uint32_t p) { return CutRecord::preorderOf(en) < p; }) - e);
           ok = rough[i][past[i]] == rough[i][cursor[i]];
@@ -204,8 +211,7 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
           above = false;
         }
       }
-      for (int i = 0; i < count; ++i)
-        if (exact >> i & 1) coverEnd[i] = nodeEnd;
+      for (uint32_t m = exact; m; m &= m - 1) coverEnd[std::countr_zero(m)] = nodeEnd;
       if (above) {
         // The finer samples' next entries lie in this node's subtree; the samples that kept
         // the node lend it their states until its end.
@@ -213,22 +219,26 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
         continue;
       }
       pos = nodeEnd;
-      int visible = 0, occluded = 0, partial = 0, firstOrder = 0, exacts = 0;
+      // Every sample has a state here (none is kAbove): the counts from its bytes at once,
+      // the visibility's two bits and the first-order bit of each.
+      static_assert(uint8_t(CutVisibility::Visible) == 0 && uint8_t(CutVisibility::Occluded) == 1 &&
+                    uint8_t(CutVisibility::Partial) == 3 && kFirstOrderBit == 4 && kMaxSamples == 4);
+      const uint32_t lanes = count >= 4 ? 0x01010101u : 0x01010101u & ((1u << (8 * count)) - 1);
+      // (A byte sum, not std::popcount: without -mpopcnt that is a call into libgcc.)
+      auto ones = [](uint32_t bytes) { return int((bytes * 0x01010101u) >> 24); };
+      const uint32_t lo = state & lanes, hi = state >> 1 & lanes;
+      const int visible = ones(lanes & ~(lo | hi)), occluded = ones(lo & ~hi), partial = ones(lo & hi),
+                firstOrder = ones(state >> 2 & lanes);
+      int exacts = 0;
       float factorSum = 0;
       bool summed = false;
-      for (int i = 0; i < count; ++i) {
-        firstOrder += (stateOf(state, i) & kFirstOrderBit) != 0;
-        if (exact >> i & 1) {
-          const std::vector<float>& f = samples[i]->factor;
-          const std::vector<uint8_t>& su = samples[i]->summed;
-          ++exacts;
-          factorSum += exactAt[i] < f.size() ? f[exactAt[i]] : 1.0f;
-          summed |= exactAt[i] < su.size() && su[exactAt[i]] != 0;
-        }
-        auto s = CutVisibility(stateOf(state, i) & 3);
-        visible += s == CutVisibility::Visible;
-        occluded += s == CutVisibility::Occluded;
-        partial += s == CutVisibility::Partial;
+      for (uint32_t m = exact; m; m &= m - 1) {
+        const int i = std::countr_zero(m);
+        const std::vector<float>& f = samples[i]->factor;
+        const std::vector<uint8_t>& su = samples[i]->summed;
+        ++exacts;
+        factorSum += exactAt[i] < f.size() ? f[exactAt[i]] : 1.0f;
+        summed |= exactAt[i] < su.size() && su[exactAt[i]] != 0;
       }
       if (count > 0 && occluded == count) {
         ++out.occluded;
