@@ -533,6 +533,68 @@ TEST(Reconstruction, MergedCutTakesTheFinerEntryOnEachSide) {
   for (size_t i = 0; i < 3; ++i) EXPECT_EQ(m2.nodes[i].node, m.nodes[i].node);
 }
 
+// One to four samples that each kept the root, with every visibility and first-order flag:
+// the merged node follows the rule of reconstruction.h for each combination (left out when
+// every sample found it occluded; a ray where any found it occluded or through glass, or
+// none found it visible; the samples' first-order factor averaged where all used one). The
+// merge counts these from the samples' packed states at once (mergeCuts), so every sample
+// count, and the lanes beyond it, are checked.
+TEST(Reconstruction, MergedNodeFollowsEveryCombinationOfItsSamplesStates) {
+  LightSet lights = cloud(64, LightType::Omni, 5);
+  LightForest forest = buildLightForest(lights);
+  auto lc = makeLightcuts(lights, forest, CutOptions{});
+  const NodeRef root = forest.trees[0].root;
+  const CutVisibility kinds[4] = {CutVisibility::Visible, CutVisibility::Occluded, CutVisibility::Untested,
+                                  CutVisibility::Partial};
+  CutRecord records[4];
+  MergedCut m;
+  int merges = 0;
+  for (int count = 1; count <= 4; ++count) {
+    int combos = 1;
+    for (int i = 0; i < count; ++i) combos *= 8;
+    for (int combo = 0; combo < combos; ++combo) {
+      int visible = 0, occluded = 0, partial = 0, firstOrder = 0;
+      float factorSum = 0;
+      const CutRecord* samples[4];
+      for (int i = 0, code = combo; i < count; ++i, code /= 8) {
+        const CutVisibility v = kinds[code % 4];
+        const bool fo = code / 4 % 2 != 0;
+        CutRecord& r = records[i];
+        r.clear();
+        r.valid = true;
+        r.entries = {CutRecord::pack(0, v, fo)};
+        r.nodes = {root};
+        r.factor = {1.0f + 0.25f * float(i)};
+        r.treeBegin = {0, 1};
+        r.finish();
+        samples[i] = &r;
+        visible += v == CutVisibility::Visible;
+        occluded += v == CutVisibility::Occluded;
+        partial += v == CutVisibility::Partial;
+        firstOrder += fo;
+        factorSum += r.factor[0];
+      }
+      lc->mergeSamples(samples, count, m);
+      ++merges;
+      SCOPED_TRACE(::testing::Message() << "samples " << count << ", combination " << combo);
+      if (occluded == count) {
+        EXPECT_TRUE(m.nodes.empty());
+        EXPECT_EQ(m.occluded, 1u);
+        continue;
+      }
+      ASSERT_EQ(m.nodes.size(), 1u);
+      EXPECT_EQ(m.occluded, 0u);
+      const MergedCut::Node& n = m.nodes[0];
+      EXPECT_EQ(n.node, root);
+      EXPECT_EQ(n.needsRay, occluded > 0 || partial > 0 || visible == 0);
+      EXPECT_EQ(n.disagree, occluded > 0 || partial > 0);
+      EXPECT_EQ(n.batched, !n.needsRay);
+      EXPECT_FLOAT_EQ(n.factor, firstOrder == count ? factorSum / float(count) : 1.0f);
+    }
+  }
+  EXPECT_EQ(merges, 8 + 64 + 512 + 4096);
+}
+
 // Spots whose cone edges cross the receiver: a small cluster across an edge is a 0-or-all
 // sample of its representative, so the samples' cuts estimate it by its exact sum
 // (CutRecord::summed), and a point between them must too, all but the dimmest, whose
