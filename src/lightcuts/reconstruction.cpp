@@ -106,9 +106,18 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
     // step, the pointers were loaded again after each store to the output).
     const uint32_t* entries[kMaxSamples];
     const NodeRef* entryNodes[kMaxSamples];
+    // ... and their factors and summed flags, as many as each record has (a record without
+    // them: 1 and not summed).
+    const float* factors[kMaxSamples];
+    const uint8_t* summedFlags[kMaxSamples];
+    size_t factorCount[kMaxSamples], summedCount[kMaxSamples];
     for (int i = 0; i < count; ++i) {
       entries[i] = samples[i]->entries.data();
       entryNodes[i] = samples[i]->nodes.data();
+      factors[i] = samples[i]->factor.data();
+      factorCount[i] = samples[i]->factor.size();
+      summedFlags[i] = samples[i]->summed.data();
+      summedCount[i] = samples[i]->summed.size();
       cursor[i] = samples[i]->treeBegin[t];
       end[i] = samples[i]->treeBegin[t + 1];
       coverEnd[i] = 0;
@@ -234,11 +243,9 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       bool summed = false;
       for (uint32_t m = exact; m; m &= m - 1) {
         const int i = std::countr_zero(m);
-        const std::vector<float>& f = samples[i]->factor;
-        const std::vector<uint8_t>& su = samples[i]->summed;
         ++exacts;
-        factorSum += exactAt[i] < f.size() ? f[exactAt[i]] : 1.0f;
-        summed |= exactAt[i] < su.size() && su[exactAt[i]] != 0;
+        factorSum += exactAt[i] < factorCount[i] ? factors[i][exactAt[i]] : 1.0f;
+        summed |= exactAt[i] < summedCount[i] && summedFlags[i][exactAt[i]] != 0;
       }
       if (count > 0 && occluded == count) {
         ++out.occluded;
