@@ -85,9 +85,7 @@ void MergedBatch::add(const Light& rep, const LightGroup& g, const Color& intens
   const size_t block = count / 4, lane = count % 4;
   if (lane == 0) {
     // A new block, its lanes harmless until filled: lights at the origin of zero intensity.
-    Block empty{};
-    empty.attMax = splat(kInf);
-    blocks.push_back(empty);
+    blocks.emplace_back().attMax = splat(kInf);  // zeroed in place, not copied
   }
   Block& b = blocks[block];
   const bool o = rep.type == LightType::Oriented;
