@@ -89,6 +89,13 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       rough[i] = r.rough.data();
     }
   }
+  // A merged node's counts are taken from the packed state's bytes at once (below): the low
+  // bit of each sample's byte, and a byte sum (not std::popcount: without -mpopcnt that is a
+  // call into libgcc).
+  static_assert(uint8_t(CutVisibility::Visible) == 0 && uint8_t(CutVisibility::Occluded) == 1 &&
+                uint8_t(CutVisibility::Partial) == 3 && kFirstOrderBit == 4 && kMaxSamples == 4);
+  const uint32_t lanes = count >= 4 ? 0x01010101u : 0x01010101u & ((1u << (8 * count)) - 1);
+  auto ones = [](uint32_t bytes) { return int((bytes * 0x01010101u) >> 24); };
   // The samples' spread: the largest distance between two of them, squared.
   float spread2 = 0;
   for (int i = 0; i < count; ++i)
@@ -230,11 +237,6 @@ void mergeCuts(const LightSet& lights, const LightForest& forest, const CutRecor
       pos = nodeEnd;
       // Every sample has a state here (none is kAbove): the counts from its bytes at once,
       // the visibility's two bits and the first-order bit of each.
-      static_assert(uint8_t(CutVisibility::Visible) == 0 && uint8_t(CutVisibility::Occluded) == 1 &&
-                    uint8_t(CutVisibility::Partial) == 3 && kFirstOrderBit == 4 && kMaxSamples == 4);
-      const uint32_t lanes = count >= 4 ? 0x01010101u : 0x01010101u & ((1u << (8 * count)) - 1);
-      // (A byte sum, not std::popcount: without -mpopcnt that is a call into libgcc.)
-      auto ones = [](uint32_t bytes) { return int((bytes * 0x01010101u) >> 24); };
       const uint32_t lo = state & lanes, hi = state >> 1 & lanes;
       const int visible = ones(lanes & ~(lo | hi)), occluded = ones(lo & ~hi), partial = ones(lo & hi),
                 firstOrder = ones(state >> 2 & lanes);
