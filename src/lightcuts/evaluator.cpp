@@ -596,7 +596,7 @@ class Lightcuts final : public LightEvaluator {
     // --max-cut still refines its large trees. Stopping at the roots left a 15,000-light
     // tree as one representative (errors of 1,000% beside 15,000 one-spot trees).
     const uint32_t maxCut = uint32_t(opt_.maxCut) + std::max(cutRoots, 1u) - 1;
-    const float eps = opt_.errorRatio;
+    const float eps = std::max(opt_.errorRatio, sp.minError);
     const double rssFactor2 = kTotalFactor * kTotalFactor;
     while (!heap.empty()) {
       // Weber's law has a floor: below errorFloor (set by the renderer from the image's
@@ -768,7 +768,7 @@ class Lightcuts final : public LightEvaluator {
     if (record && !summedAt.empty()) {
       // The dimmest summed nodes are left to their representatives (kUnsummedShare).
       std::sort(summedAt.begin(), summedAt.end());
-      double budget = double(kUnsummedShare) * opt_.errorRatio * luminance(total);
+      double budget = double(kUnsummedShare) * eps * luminance(total);
       for (const auto& [u, at] : summedAt) {
         if (u > budget) break;
         budget -= u;

@@ -175,6 +175,36 @@ TEST_P(CutMethods, ErrorFloorBoundsAbsoluteError) {
   }
 }
 
+// ShadingPoint::minError (the error floor's pre-pass): at or below the evaluator's --error
+// it changes nothing, bit for bit; above it the cut is held to that looser error instead,
+// so it is smaller and errs within it.
+TEST_P(CutMethods, MinErrorLoosensTheCutOnlyAboveTheEvaluatorsError) {
+  LightSet s = cloud(20000, GetParam(), 4);
+  LightForest f = buildLightForest(s);
+  auto bf = makeBruteForce(s);
+  auto lc = makeLightcuts(s, f, CutOptions{0.02f, 4000});
+  HalfBlocked vis;
+  int looser = 0;
+  for (int i = 0; i < 20; ++i) {
+    ShadingPoint sp = point(Vec3(float(i) * 0.3f - 3, 0, 0.2f * float(i) - 2));
+    EvalStats st;
+    double exact = luminance(bf->evaluate(sp, vis, st).radiance);
+    EvalResult none = lc->evaluate(sp, vis, st);
+    sp.minError = 0.02f;
+    EvalResult same = lc->evaluate(sp, vis, st);
+    EXPECT_EQ(none.radiance, same.radiance);
+    EXPECT_EQ(none.cutSize, same.cutSize);
+    sp.minError = 0.1f;
+    EvalResult loose = lc->evaluate(sp, vis, st);
+    EXPECT_LE(loose.cutSize, none.cutSize);
+    looser += loose.cutSize < none.cutSize;
+    if (exact > 0) {
+      EXPECT_LT(std::fabs(luminance(loose.radiance) - exact), 0.1 * exact) << i;
+    }
+  }
+  EXPECT_GE(looser, 15);
+}
+
 INSTANTIATE_TEST_SUITE_P(Kinds, CutMethods, ::testing::Values(LightType::Omni, LightType::Oriented),
                          [](const auto& info) { return std::string(lightTypeName(info.param)); });
 

@@ -23,6 +23,10 @@ struct ShadingPoint {
   // stops when its bounds are within error x max(estimate, errorFloor)): the renderer's
   // --error-floor, divided by the weight this point's light has in its pixel. 0 = none.
   float errorFloor = 0;
+  // The relative error this point's cut is held to is at least this (the evaluator's
+  // --error otherwise): the error floor's pre-pass (render/renderer.cpp), which needs only
+  // the image's mean luminance, asks for less. 0 = the evaluator's alone.
+  float minError = 0;
 
   bool hasSpecular() const { return !isBlack(ks); }
   bool isBlackBody() const { return isBlack(kd) && isBlack(ks); }

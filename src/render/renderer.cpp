@@ -70,6 +70,7 @@ float autoErrorFloor(const Scene& scene, const LightEvaluator& evaluator, const 
   RenderOptions pre = o;
   pre.spp = 1;
   pre.errorFloor = 0;
+  pre.minError = kErrorFloorPrePassError;
   const int gx = std::min(o.width, kErrorFloorGrid), gy = std::min(o.height, kErrorFloorGrid);
   pixels = uint64_t(gx) * uint64_t(gy);
   std::vector<double> lum(pixels, 0.0);

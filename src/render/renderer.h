@@ -158,6 +158,9 @@ struct RenderOptions {
   // criterion); < 0 = automatic: kAutoErrorFloorFraction of the mean luminance of a
   // kErrorFloorGrid^2 pre-pass over the image without a floor.
   float errorFloor = 0;
+  // The least relative error a cut is held to (ShadingPoint::minError): set by the
+  // automatic floor's pre-pass to kErrorFloorPrePassError; 0 = the evaluator's --error.
+  float minError = 0;
   // Set from a signal handler to stop early; the result is marked interrupted.
   std::atomic<bool>* cancel = nullptr;
   // Called from one thread with the fraction done (0..1), about ten times a second.
@@ -192,6 +195,12 @@ struct ReferenceStats {
 // from a pre-pass of 32 x 32 pixel centres.
 constexpr float kAutoErrorFloorFraction = 0.005f;
 constexpr int kErrorFloorGrid = 32;
+// The pre-pass holds each pixel to at least this relative error: its mean, and so the
+// floor, is then within this of the mean of exact pixels (in practice far closer, the
+// pixels' errors being of both signs), and the floor is a fraction of the metric's with
+// room to spare. At 2% the pre-pass cost 7% of a 64 x 64 render (docs/LIGHTCUTS.md,
+// "Error floor").
+constexpr float kErrorFloorPrePassError = 0.1f;
 
 struct RenderStats {
   double seconds = 0;  // with the error floor's pre-pass

@@ -310,5 +310,37 @@ scale(1e15, scale(1e15, sphere { material = { diffuse = (0.5, 0.5, 0.5); reflect
   for (const Color& c : f.image.pixels) EXPECT_TRUE(isFinite(c)) << c.x;
 }
 
+// --error-floor auto: kAutoErrorFloorFraction of the mean luminance of its pre-pass, whose
+// pixels are held to kErrorFloorPrePassError (not --error): at 32 x 32 the pre-pass is every
+// pixel, so the floor is within that error (in practice far less) of the fraction of the
+// mean of a brute-force image.
+TEST(ErrorFloor, AutoFloorIsTheFractionOfTheMeanOfItsPrePass) {
+  std::string text = R"(SBT-raytracer 1.0
+camera { position = (0, 2, 6); viewdir = (0, -0.3, -1); updir = (0, 1, 0); fov = 60; }
+scale(12, rotate(1, 0, 0, -1.5707963, square { material = { diffuse = (0.8, 0.8, 0.8); }; }))
+translate(0, 0.5, 0, box { material = { diffuse = (0.7, 0.3, 0.2); }; })
+)";
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 20; ++j)
+      text += "point_light { position = (" + std::to_string(-2 + 0.2 * i) + ", 2.5, " + std::to_string(-2 + 0.2 * j) +
+              "); colour = (0.01, 0.01, 0.01); }\n";
+  auto s = sceneFrom(text);
+  auto forest = lightcuts::buildLightForest(s->lights());
+  auto lc = lightcuts::makeLightcuts(s->lights(), forest, lightcuts::CutOptions{});
+  RenderOptions o;
+  o.aa = AntiAliasing::Off;
+  o.width = o.height = kErrorFloorGrid;
+  o.errorFloor = -1;
+  RenderResult r = render(*s, *lc, o);
+  EXPECT_EQ(r.stats.errorFloorPixels, uint64_t(kErrorFloorGrid * kErrorFloorGrid));
+  RenderResult b = renderBrute(*s, kErrorFloorGrid, kErrorFloorGrid);
+  double sum = 0;
+  for (const Color& c : b.image.pixels) sum += std::max(0.0f, luminance(c));
+  const double want = kAutoErrorFloorFraction * sum / double(b.image.pixels.size());
+  ASSERT_GT(want, 0);
+  EXPECT_NEAR(r.stats.errorFloor, want, 0.02 * want);
+  EXPECT_NE(r.stats.errorFloor, 0.0f);
+}
+
 }  // namespace
 }  // namespace lc::render

@@ -215,6 +215,7 @@ Color Tracer::trace(const scene::Ray& ray, int depth, float weight) {
     sp.ks = m.ks;
     sp.shininess = m.shininess;
     sp.errorFloor = errorFloor > 0 && weight > 0 ? errorFloor / weight : 0;
+    sp.minError = minError;
     lightcuts::EvalResult r = directLight(h, sp, depth);
     L += r.radiance;
     cutNodes += r.cutSize;
@@ -262,6 +263,7 @@ PixelResult renderPixel(const scene::Scene& scene, const lightcuts::LightEvaluat
   const uint64_t rays0 = stats.shadowRays;
   Tracer tr{scene, ev, o.maxDepth, stats, hook};
   tr.errorFloor = std::max(0.0f, o.errorFloor);
+  tr.minError = o.minError;
   Color sum(0);
   const scene::Camera& cam = scene.camera();
   static thread_local std::vector<Vec2> positions;
