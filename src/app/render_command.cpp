@@ -650,10 +650,10 @@ void addRenderCommand(CLI::App& app) {
       ->group(cuts);
   c->add_option("--error-floor", a->errorFloor,
                 fmt::format("Lightcuts: luminance below which --error is an absolute error (a cut stops within error x "
-                            "max(estimate, floor)); auto = {} x the mean luminance of a {} x {} pre-pass (half the "
-                            "floor of compare's relative error), 0 = none (as published); default {}",
+                            "max(estimate, floor)); auto = {} x the mean luminance of a {} x {} pre-pass of cuts within max(--error, {}%) "
+                            "(half the floor of compare's relative error), 0 = none (as published); default {}",
                             render::kAutoErrorFloorFraction, render::kErrorFloorGrid, render::kErrorFloorGrid,
-                            d.errorFloor))
+                            100 * render::kErrorFloorPrePassError, d.errorFloor))
       ->check(CLI::IsMember({"auto"}) | CLI::Range(0.0, 1e30))
       ->group(cuts);
   addEnumOption(*c, "--cut-criterion", lightcuts::kCutCriterionNames,
