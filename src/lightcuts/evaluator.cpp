@@ -494,15 +494,9 @@ class Lightcuts final : public LightEvaluator {
         // A node in the heap may be refined next: fetch its children while we work (a
         // leaf child: its light).
         const NodeRef left = n.left(ni), right = n.right(ni);
-        for (NodeRef c : {left, right}) {
+        for (NodeRef c : {left, right})
           __builtin_prefetch(isLeafRef(c) ? static_cast<const void*>(&lights_.lights[leafLight(c)])
                                           : static_cast<const void*>(&tree.nodes[c]));
-          // An inner child's next slot holds its first inner child (its left one, or its
-          // right one when the left is a light): fetched now, it arrives a refinement
-          // earlier than the child's own prefetch would bring it. Half the misses of a
-          // 682 MiB tree (10M VPLs) start one refinement sooner (docs/BENCHMARKS.md).
-          if (!isLeafRef(c) && c + 1 < tree.nodes.size()) __builtin_prefetch(&tree.nodes[c + 1]);
-        }
         if (freshCount < 2) fresh[freshCount++] = {t, left, right};
         const float lo = luminance(lower);
         // A hidden representative's spread stays its whole upper bound. (Counting its
