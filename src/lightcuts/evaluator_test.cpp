@@ -143,65 +143,67 @@ TEST_P(CutMethods, ErrorStaysNearTheThresholdAndCutsAreSmall) {
   EXPECT_GE(stt.cutNodes, stw.cutNodes);
 }
 
+// Twenty points under a cloud of 20,000 lights, half of whose rays are blocked: `check`
+// gets each point, its brute-force luminance and its cut (a function of the point, for the
+// knobs of ShadingPoint).
+template <class Check>
+void forCloudPoints(LightType type, Check check) {
+  LightSet s = cloud(20000, type, 4);
+  LightForest f = buildLightForest(s);
+  auto bf = makeBruteForce(s);
+  auto lc = makeLightcuts(s, f, CutOptions{0.02f, 4000});
+  HalfBlocked vis;
+  EvalStats st;
+  auto cut = [&](const ShadingPoint& sp) { return lc->evaluate(sp, vis, st); };
+  for (int i = 0; i < 20; ++i) {
+    ShadingPoint sp = point(Vec3(float(i) * 0.3f - 3, 0, 0.2f * float(i) - 2));
+    check(i, sp, double(luminance(bf->evaluate(sp, vis, st).radiance)), cut);
+  }
+}
+
 // The error floor (ShadingPoint::errorFloor): below it the criterion is an absolute error
 // of errorRatio x floor. A floor of 0 is the published criterion, bit for bit; a floor
 // far above the point's light stops the cut early and keeps its error within a few times
 // errorRatio x floor; one far below changes nothing.
 TEST_P(CutMethods, ErrorFloorBoundsAbsoluteError) {
-  LightSet s = cloud(20000, GetParam(), 4);
-  LightForest f = buildLightForest(s);
-  auto bf = makeBruteForce(s);
-  auto lc = makeLightcuts(s, f, CutOptions{0.02f, 4000});
-  HalfBlocked vis;
-  for (int i = 0; i < 20; ++i) {
-    ShadingPoint sp = point(Vec3(float(i) * 0.3f - 3, 0, 0.2f * float(i) - 2));
-    EvalStats st;
-    double exact = luminance(bf->evaluate(sp, vis, st).radiance);
-    EvalResult none = lc->evaluate(sp, vis, st);
-    if (!(exact > 0)) continue;  // all hidden: no floor to scale
+  forCloudPoints(GetParam(), [](int i, ShadingPoint sp, double exact, auto cut) {
+    EvalResult none = cut(sp);
+    if (!(exact > 0)) return;  // all hidden: no floor to scale
     sp.errorFloor = 0;
-    EvalResult zero = lc->evaluate(sp, vis, st);
+    EvalResult zero = cut(sp);
     EXPECT_EQ(none.radiance, zero.radiance);
     EXPECT_EQ(none.cutSize, zero.cutSize);
     sp.errorFloor = float(exact * 1e-3);
-    EvalResult low = lc->evaluate(sp, vis, st);
+    EvalResult low = cut(sp);
     EXPECT_EQ(low.radiance, none.radiance);
     const float floor = float(exact * 20);
     sp.errorFloor = floor;
-    EvalResult high = lc->evaluate(sp, vis, st);
+    EvalResult high = cut(sp);
     EXPECT_LT(high.cutSize, none.cutSize);
     // The total criterion's error spreads sum to 1.6 x the limit; the estimate errs by less.
     EXPECT_LT(std::fabs(luminance(high.radiance) - exact), 3 * 0.02 * floor) << i;
-  }
+  });
 }
 
 // ShadingPoint::minError (the error floor's pre-pass): at or below the evaluator's --error
 // it changes nothing, bit for bit; above it the cut is held to that looser error instead,
 // so it is smaller and errs within it.
 TEST_P(CutMethods, MinErrorLoosensTheCutOnlyAboveTheEvaluatorsError) {
-  LightSet s = cloud(20000, GetParam(), 4);
-  LightForest f = buildLightForest(s);
-  auto bf = makeBruteForce(s);
-  auto lc = makeLightcuts(s, f, CutOptions{0.02f, 4000});
-  HalfBlocked vis;
   int looser = 0;
-  for (int i = 0; i < 20; ++i) {
-    ShadingPoint sp = point(Vec3(float(i) * 0.3f - 3, 0, 0.2f * float(i) - 2));
-    EvalStats st;
-    double exact = luminance(bf->evaluate(sp, vis, st).radiance);
-    EvalResult none = lc->evaluate(sp, vis, st);
+  forCloudPoints(GetParam(), [&looser](int i, ShadingPoint sp, double exact, auto cut) {
+    EvalResult none = cut(sp);
     sp.minError = 0.02f;
-    EvalResult same = lc->evaluate(sp, vis, st);
+    EvalResult same = cut(sp);
     EXPECT_EQ(none.radiance, same.radiance);
     EXPECT_EQ(none.cutSize, same.cutSize);
     sp.minError = 0.1f;
-    EvalResult loose = lc->evaluate(sp, vis, st);
+    EvalResult loose = cut(sp);
     EXPECT_LE(loose.cutSize, none.cutSize);
     looser += loose.cutSize < none.cutSize;
     if (exact > 0) {
       EXPECT_LT(std::fabs(luminance(loose.radiance) - exact), 0.1 * exact) << i;
     }
-  }
+  });
   EXPECT_GE(looser, 15);
 }
 
