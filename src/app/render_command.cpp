@@ -677,7 +677,8 @@ void addRenderCommand(CLI::App& app) {
             fmt::format("Lightcuts: test a cluster whose representative is visible for being visible as a whole, "
                         "without rays (every surface's bounding volume apart from the hull of the point and the "
                         "cluster); such clusters are refined without shadow rays and carry no visibility error "
-                        "(on) or every representative casts its ray (off, as published); default {}",
+                        "(on; with --error-floor auto, not where fewer than one in 16 of its pre-pass's tests passed"
+                        ") or every representative casts its ray (off, as published); default {}",
                         switchName(d.clearClusters)))
       ->group(cuts);
   addSwitch(*c, "--second-samples", a->secondSamples,

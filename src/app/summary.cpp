@@ -191,6 +191,11 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
   j["occluded_shadow_rays"] = es.occludedRays;
   j["hidden_clusters"] = es.hiddenClusters;
   j["clear_clusters"] = switchName(a.clearClusters);
+  // What the floor's pre-pass found of the tests, and whether the render kept them
+  // (lightcuts::clearTestsPay: off where under one in 16 passed).
+  j["pre_pass_clear_tests"] = rr.stats.prePass.clearTests;
+  j["pre_pass_cleared_clusters"] = rr.stats.prePass.clearedClusters;
+  j["clear_tests_kept"] = switchName(a.clearClusters && rr.stats.clearTests);
   j["clear_tests"] = es.clearTests;
   j["cleared_clusters"] = es.clearedClusters;
   j["cuts_at_max_cut"] = es.cutsAtMaxCut;

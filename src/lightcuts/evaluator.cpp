@@ -435,7 +435,7 @@ class Lightcuts final : public LightEvaluator {
     const bool rss = opt_.criterion == CutCriterion::Total;
     const bool firstOrder = opt_.estimator == Estimator::FirstOrder;
     const bool probes = opt_.visibilityProbes;
-    const bool clearTests = opt_.clearClusters;
+    const bool clearTests = opt_.clearClusters && sp.clearTests;
     uint32_t clearFailures = 0, clearSuccesses = 0;
 
     // Inner nodes pushed by the last refinement (tree, children): their children's lights
@@ -1005,6 +1005,12 @@ void coinRatesBySize(const uint32_t tested[kCoinSizeClasses], const uint32_t spl
 
 std::unique_ptr<LightEvaluator> makeBruteForce(const LightSet& lights) {
   return std::make_unique<BruteForce>(lights);
+}
+
+// Tests enough to judge a rate of one in kClearMinLights by.
+constexpr uint64_t kClearJudgedTests = 1000;
+bool clearTestsPay(uint64_t tests, uint64_t passed) {
+  return tests < kClearJudgedTests || passed * kClearMinLights >= tests;
 }
 std::unique_ptr<LightEvaluator> makeLightcuts(const LightSet& lights, const LightForest& forest,
                                               const CutOptions& options) {

@@ -150,6 +150,13 @@ class LightEvaluator {
   }
 };
 
+// Whether clear tests (CutOptions::clearClusters) pay where `passed` of `tests` passed: a
+// test costs about a shadow ray, and a pass spares the rays of a cluster of at least
+// kClearMinLights (16) lights, so they pay from one pass in 16. Too few tests to tell:
+// yes. Measured (docs/BENCHMARKS.md): 17-24% pass in open scenes, 0.2% in the suite's
+// occluded interiors, where they cost 2-10% of a render for nothing.
+bool clearTestsPay(uint64_t tests, uint64_t passed);
+
 // `lights` (and `forest`) must outlive the evaluator.
 std::unique_ptr<LightEvaluator> makeBruteForce(const LightSet& lights);
 std::unique_ptr<LightEvaluator> makeLightcuts(const LightSet& lights, const LightForest& forest,

@@ -207,6 +207,34 @@ TEST_P(CutMethods, MinErrorLoosensTheCutOnlyAboveTheEvaluatorsError) {
   EXPECT_GE(looser, 15);
 }
 
+// Clear tests pay from one pass in kClearMinLights (16), once there are enough to judge.
+TEST(ClearTests, PayFromOnePassInSixteen) {
+  EXPECT_TRUE(clearTestsPay(0, 0));
+  EXPECT_TRUE(clearTestsPay(999, 0));  // too few to tell
+  EXPECT_FALSE(clearTestsPay(1000, 0));
+  EXPECT_TRUE(clearTestsPay(1600, 100));
+  EXPECT_FALSE(clearTestsPay(1600, 99));
+  EXPECT_TRUE(clearTestsPay(49000, 49000));
+}
+
+// ShadingPoint::clearTests off: the cut tests no cluster; where no test would pass (no
+// implementation of boxClear) its light is the same bit for bit.
+TEST(Lightcuts, ClearTestsOnlyWhereThePointAllowsThem) {
+  LightSet s = cloud(20000, LightType::Omni, 4);
+  LightForest f = buildLightForest(s);
+  auto lc = makeLightcuts(s, f, CutOptions{0.02f, 4000});
+  HalfBlocked vis;
+  ShadingPoint sp = point(Vec3(0.3f, 0, -0.5f));
+  EvalStats on, off;
+  EvalResult a = lc->evaluate(sp, vis, on);
+  sp.clearTests = false;
+  EvalResult b = lc->evaluate(sp, vis, off);
+  EXPECT_GT(on.clearTests, 0u);
+  EXPECT_EQ(off.clearTests, 0u);
+  EXPECT_EQ(a.radiance, b.radiance);
+  EXPECT_EQ(a.cutSize, b.cutSize);
+}
+
 INSTANTIATE_TEST_SUITE_P(Kinds, CutMethods, ::testing::Values(LightType::Omni, LightType::Oriented),
                          [](const auto& info) { return std::string(lightTypeName(info.param)); });
 

@@ -27,6 +27,9 @@ struct ShadingPoint {
   // --error otherwise): the error floor's pre-pass (render/renderer.cpp), which needs only
   // the image's mean luminance, asks for less. 0 = the evaluator's alone.
   float minError = 0;
+  // Whether the cut may test clusters for being clear (CutOptions::clearClusters): the
+  // renderer turns the tests off where its pre-pass found they rarely pass (clearTestsPay).
+  bool clearTests = true;
 
   bool hasSpecular() const { return !isBlack(ks); }
   bool isBlackBody() const { return isBlack(kd) && isBlack(ks); }

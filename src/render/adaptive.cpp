@@ -288,6 +288,7 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
     Tracer tr{scene, ev, o.maxDepth, stats, rt ? &hook : nullptr};
     tr.errorFloor = std::max(0.0f, o.errorFloor);  // as at the pixel's centre (renderPixel)
     tr.minError = o.minError;
+    tr.clearTests = o.clearTests;
     if (!decouple) ++primary;
     Color c = tr.trace(b.ray, 0);
     if (!isFinite(c)) c = Color(0);

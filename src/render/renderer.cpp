@@ -66,7 +66,8 @@ namespace {
 
 // The automatic error floor: kAutoErrorFloorFraction of the mean luminance of up to
 // kErrorFloorGrid^2 pixel centres spread over the image, rendered without a floor.
-float autoErrorFloor(const Scene& scene, const LightEvaluator& evaluator, const RenderOptions& o, uint64_t& pixels) {
+float autoErrorFloor(const Scene& scene, const LightEvaluator& evaluator, const RenderOptions& o, uint64_t& pixels,
+                     EvalStats& prePass) {
   RenderOptions pre = o;
   pre.spp = 1;
   pre.errorFloor = 0;
@@ -81,6 +82,7 @@ float autoErrorFloor(const Scene& scene, const LightEvaluator& evaluator, const 
     uint64_t a = 0, b = 0;
     lum[size_t(i)] = std::max(0.0f, luminance(renderPixel(scene, evaluator, pre, x, y, stats.local(), a, b).color));
   });
+  stats.combine_each([&](const EvalStats& s) { prePass.add(s); });  // counts: any order
   double sum = 0;
   for (double l : lum) sum += l;  // in pixel order: the same floor whatever the threads
   double mean = pixels > 0 ? sum / double(pixels) : 0;
@@ -137,9 +139,12 @@ RenderResult render(const Scene& scene, const LightEvaluator& evaluator, const R
   const auto tFloor = Clock::now();
   if (o.errorFloor < 0) {
     o.errorFloor = evaluator.method() == lightcuts::Method::Lightcuts
-                       ? autoErrorFloor(scene, evaluator, o, res.stats.errorFloorPixels)
+                       ? autoErrorFloor(scene, evaluator, o, res.stats.errorFloorPixels, res.stats.prePass)
                        : 0.0f;
+    // Clear tests stay on only where the pre-pass found them worth their cost.
+    o.clearTests = lightcuts::clearTestsPay(res.stats.prePass.clearTests, res.stats.prePass.clearedClusters);
   }
+  res.stats.clearTests = o.clearTests;
   if (!std::isfinite(o.errorFloor)) o.errorFloor = 0;
   res.stats.errorFloor = o.errorFloor;
   const double floorSeconds = secondsSince(tFloor);

@@ -161,6 +161,9 @@ struct RenderOptions {
   // The least relative error a cut is held to (ShadingPoint::minError): set by the
   // automatic floor's pre-pass to kErrorFloorPrePassError; 0 = the evaluator's --error.
   float minError = 0;
+  // Whether cuts may test clusters for being clear (ShadingPoint::clearTests): with the
+  // automatic floor, set from its pre-pass (lightcuts::clearTestsPay).
+  bool clearTests = true;
   // Set from a signal handler to stop early; the result is marked interrupted.
   std::atomic<bool>* cancel = nullptr;
   // Called from one thread with the fraction done (0..1), about ten times a second.
@@ -206,6 +209,8 @@ struct RenderStats {
   double seconds = 0;  // with the error floor's pre-pass
   float errorFloor = 0;  // the floor used (RenderOptions::errorFloor, resolved)
   uint64_t errorFloorPixels = 0;  // pixels of the automatic floor's pre-pass
+  lightcuts::EvalStats prePass;   // the pre-pass's counts (its clear tests, above all)
+  bool clearTests = true;         // RenderOptions::clearTests, resolved
   double tileSeconds = 0;  // from the start until this process's last tile was rendered
   uint64_t tiles = 0;      // tiles rendered here
   uint64_t pixels = 0;     // pixels of those tiles

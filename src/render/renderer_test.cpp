@@ -340,6 +340,10 @@ translate(0, 0.5, 0, box { material = { diffuse = (0.7, 0.3, 0.2); }; })
   ASSERT_GT(want, 0);
   EXPECT_NEAR(r.stats.errorFloor, want, 0.02 * want);
   EXPECT_NE(r.stats.errorFloor, 0.0f);
+  // The pre-pass also decides whether the render's cuts test clusters for being clear.
+  EXPECT_GT(r.stats.prePass.clearTests, 0u);
+  EXPECT_EQ(r.stats.clearTests, lightcuts::clearTestsPay(r.stats.prePass.clearTests, r.stats.prePass.clearedClusters));
+  EXPECT_EQ(r.stats.eval.clearTests > 0, r.stats.clearTests);
 }
 
 }  // namespace

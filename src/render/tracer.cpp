@@ -216,6 +216,7 @@ Color Tracer::trace(const scene::Ray& ray, int depth, float weight) {
     sp.shininess = m.shininess;
     sp.errorFloor = errorFloor > 0 && weight > 0 ? errorFloor / weight : 0;
     sp.minError = minError;
+    sp.clearTests = clearTests;
     lightcuts::EvalResult r = directLight(h, sp, depth);
     L += r.radiance;
     cutNodes += r.cutSize;
@@ -264,6 +265,7 @@ PixelResult renderPixel(const scene::Scene& scene, const lightcuts::LightEvaluat
   Tracer tr{scene, ev, o.maxDepth, stats, hook};
   tr.errorFloor = std::max(0.0f, o.errorFloor);
   tr.minError = o.minError;
+  tr.clearTests = o.clearTests;
   Color sum(0);
   const scene::Camera& cam = scene.camera();
   static thread_local std::vector<Vec2> positions;

@@ -81,6 +81,7 @@ struct Tracer {
   uint64_t cutNodes = 0;  // summed over the shading points of the current sample
   float errorFloor = 0;   // RenderOptions::errorFloor, resolved (a pixel's luminance)
   float minError = 0;     // RenderOptions::minError
+  bool clearTests = true;  // RenderOptions::clearTests
 
   // One shading point in kTimedPointOdds, drawn at random, is timed in the thread's CPU
   // time (a system call: timing every point would cost a few per cent of a reconstructed
