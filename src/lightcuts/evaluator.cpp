@@ -1003,15 +1003,16 @@ void coinRatesBySize(const uint32_t tested[kCoinSizeClasses], const uint32_t spl
 
 }  // namespace detail
 
-std::unique_ptr<LightEvaluator> makeBruteForce(const LightSet& lights) {
-  return std::make_unique<BruteForce>(lights);
-}
-
 // Tests enough to judge a rate of one in kClearMinLights by.
 constexpr uint64_t kClearJudgedTests = 1000;
 bool clearTestsPay(uint64_t tests, uint64_t passed) {
   return tests < kClearJudgedTests || passed * kClearMinLights >= tests;
 }
+
+std::unique_ptr<LightEvaluator> makeBruteForce(const LightSet& lights) {
+  return std::make_unique<BruteForce>(lights);
+}
+
 std::unique_ptr<LightEvaluator> makeLightcuts(const LightSet& lights, const LightForest& forest,
                                               const CutOptions& options) {
   return std::make_unique<Lightcuts>(lights, forest, options);

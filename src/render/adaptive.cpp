@@ -286,9 +286,7 @@ SubSampleSums traceSubSamples(const scene::Scene& scene, const lightcuts::LightE
     if (rt) rt->subSampleHook(b.ray, x, y, b.u, hook, chosen, *cache);
     stats.shadowRays += hook.separationRays;  // occlusion rays of the light's estimate
     Tracer tr{scene, ev, o.maxDepth, stats, rt ? &hook : nullptr};
-    tr.errorFloor = std::max(0.0f, o.errorFloor);  // as at the pixel's centre (renderPixel)
-    tr.minError = o.minError;
-    tr.clearTests = o.clearTests;
+    tr.cutSettingsFrom(o);  // as at the pixel's centre (renderPixel)
     if (!decouple) ++primary;
     Color c = tr.trace(b.ray, 0);
     if (!isFinite(c)) c = Color(0);

@@ -257,15 +257,19 @@ Color traceRay(const scene::Scene& scene, const lightcuts::LightEvaluator& evalu
   return tr.trace(ray, 0);
 }
 
+void Tracer::cutSettingsFrom(const RenderOptions& o) {
+  errorFloor = std::max(0.0f, o.errorFloor);
+  minError = o.minError;
+  clearTests = o.clearTests;
+}
+
 PixelResult renderPixel(const scene::Scene& scene, const lightcuts::LightEvaluator& ev, const RenderOptions& o, int x,
                         int y, lightcuts::EvalStats& stats, uint64_t& primary, uint64_t& secondary,
                         PrimaryLight* hook) {
   Rng rng(o.seed, uint64_t(y) * uint64_t(o.width) + uint64_t(x));
   const uint64_t rays0 = stats.shadowRays;
   Tracer tr{scene, ev, o.maxDepth, stats, hook};
-  tr.errorFloor = std::max(0.0f, o.errorFloor);
-  tr.minError = o.minError;
-  tr.clearTests = o.clearTests;
+  tr.cutSettingsFrom(o);
   Color sum(0);
   const scene::Camera& cam = scene.camera();
   static thread_local std::vector<Vec2> positions;

@@ -79,9 +79,12 @@ struct Tracer {
   PrimaryLight* hook = nullptr;
   uint64_t secondaryRays = 0;
   uint64_t cutNodes = 0;  // summed over the shading points of the current sample
-  float errorFloor = 0;   // RenderOptions::errorFloor, resolved (a pixel's luminance)
-  float minError = 0;     // RenderOptions::minError
+  // What its cuts are held to, from RenderOptions (cutSettingsFrom): every tracer of a
+  // render's points, pixel centres and sub-samples alike, takes them there.
+  float errorFloor = 0;    // RenderOptions::errorFloor, resolved (a pixel's luminance)
+  float minError = 0;      // RenderOptions::minError
   bool clearTests = true;  // RenderOptions::clearTests
+  void cutSettingsFrom(const RenderOptions& o);
 
   // One shading point in kTimedPointOdds, drawn at random, is timed in the thread's CPU
   // time (a system call: timing every point would cost a few per cent of a reconstructed
