@@ -360,7 +360,7 @@ bool setUpRender(RenderArgs& a, Cluster* cluster, RenderSetup& s) {
   if (!s.ls.objDescription.empty() && !a.quiet)
     fmt::print(stderr, "OBJ input: added a default camera and lights:\n{}\n", s.ls.objDescription);
 
-  const auto& cam = scene.desc().camera;
+  const auto& cam = scene.cameraDesc();
   resolveImageSize(a, cam);
   processBudget().reserve(uint64_t(a.width) * uint64_t(a.height) * memory_cost::kPixel,
                           fmt::format("the {}x{} image's buffers", a.width, a.height));

@@ -29,7 +29,7 @@ TEST(ShippedScenes, LoadAndRender) {
     LoadedScene ls = loadScene(path, o);
     ASSERT_GT(ls.scene->lights().size(), 0u);
     scene::Scene& s = *ls.scene;
-    s.setCamera(scene::Camera::fromDesc(s.desc().camera, 1.0f));
+    s.setCamera(scene::Camera::fromDesc(s.cameraDesc(), 1.0f));
     lightcuts::LightForest f = lightcuts::buildLightForest(s.lights());
     auto ev = lightcuts::makeLightcuts(s.lights(), f, {});
     render::RenderOptions ro;

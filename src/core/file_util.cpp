@@ -9,8 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <memory>
 
 #include "core/error.h"
 
@@ -18,16 +17,33 @@ namespace fs = std::filesystem;
 
 namespace lc {
 
-std::string readFile(const std::string& path) {
+namespace {
+
+// The whole file at `path` in a Buffer (std::string or BigVector<char>): one allocation of
+// the file's size, read into directly (through a string stream the buffer was grown and
+// copied by doubling, then copied out); a file that grows meanwhile is read to its end.
+template <class Buffer>
+Buffer readWhole(const std::string& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw Error("cannot read " + quoteInput(path) + ": it is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error("cannot open " + quoteInput(path) + ": " + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw Error("cannot read " + quoteInput(path) + "");
-  return ss.str();
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
+  std::FILE* f = file.get();
+  if (!f) throw Error("cannot open " + quoteInput(path) + ": " + std::strerror(errno));
+  struct stat st {};
+  Buffer text;
+  if (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) text.resize(size_t(st.st_size));
+  text.resize(std::fread(text.data(), 1, text.size(), f));
+  char buf[1 << 16];
+  for (size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) text.insert(text.end(), buf, buf + n);
+  if (std::ferror(f)) throw Error("cannot read " + quoteInput(path));
+  return text;
 }
+
+}  // namespace
+
+std::string readFile(const std::string& path) { return readWhole<std::string>(path); }
+
+BigVector<char> readFileBytes(const std::string& path) { return readWhole<BigVector<char>>(path); }
 
 static std::string tempNameFor(const std::string& path) {
   static std::atomic<unsigned> counter{0};

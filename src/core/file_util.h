@@ -5,10 +5,16 @@
 #include <string>
 #include <vector>
 
+#include "core/huge_pages.h"
+
 namespace lc {
 
 // Reads a whole file; throws lc::Error naming the path when it cannot.
 std::string readFile(const std::string& path);
+// The same, into huge pages and without zero-filling them first: for scene files of
+// hundreds of megabytes, whose reading into a string was mostly page faults (a 388 MB scene
+// of 2M point lights: 5.2 s through a string stream, 1.6 s into a sized string, 0.3 s here).
+BigVector<char> readFileBytes(const std::string& path);
 
 // Writes `path` atomically: `write` fills a temporary file in the same directory,
 // which is then renamed over `path`. On any failure the temporary is removed, the old

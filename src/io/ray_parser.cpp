@@ -1549,7 +1549,7 @@ void Parser::objMesh(const Token& kw, ObjectDesc& obj) {
 
 }  // namespace
 
-SceneDesc parseRayString(const std::string& text, const std::string& name, const std::string& baseDir,
+SceneDesc parseRayString(std::string_view text, const std::string& name, const std::string& baseDir,
                          const ParseOptions& options) {
   if (text.size() > options.limits.maxFileBytes)
     throw Error(quoteInput(name) + " is larger than the limit of " + std::to_string(options.limits.maxFileBytes) +
@@ -1587,7 +1587,8 @@ SceneDesc parseRayFile(const std::string& path, const ParseOptions& options) {
       throw Error("cannot read " + quoteInput(path) + ": not a regular file");
     auto size = fs::file_size(path, ec);
     if (!ec && size > limit) throw tooLarge();
-    text = readFile(path);
+    const BigVector<char> bytes = readFileBytes(path);
+    return parseRayString(std::string_view(bytes.data(), bytes.size()), path, parentDir(path), options);
   }
   return parseRayString(text, path, parentDir(path), options);
 }

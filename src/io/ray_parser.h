@@ -5,6 +5,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "core/progress.h"
 #include "core/limits.h"
@@ -31,7 +32,7 @@ struct ParseOptions {
 SceneDesc parseRayFile(const std::string& path, const ParseOptions& options = {});
 
 // Parses .ray text; `name` is used in error messages and `baseDir` resolves relative paths.
-SceneDesc parseRayString(const std::string& text, const std::string& name,
+SceneDesc parseRayString(std::string_view text, const std::string& name,
                          const std::string& baseDir, const ParseOptions& options = {});
 
 }  // namespace lc::io

@@ -129,7 +129,7 @@ Scene::~Scene() {
 std::unique_ptr<Scene> Scene::build(const io::SceneDesc& desc, const BuildOptions& options) {
   std::unique_ptr<Scene> scene(new Scene());
   Scene& s = *scene;
-  s.desc_ = desc;
+  s.cameraDesc_ = desc.camera;
   s.ambient_ = desc.ambient;
 
   // Materials, with every texture decoded once and shared.

@@ -123,14 +123,15 @@ class Scene {
   }
   LightSet& lights() { return lights_; }
   const LightSet& lights() const { return lights_; }
-  const io::SceneDesc& desc() const { return desc_; }
+  // The camera as the scene file described it (the image's aspect ratio is the caller's).
+  const io::CameraDesc& cameraDesc() const { return cameraDesc_; }
   size_t triangleCount() const;
 
  private:
   Scene() = default;
   void buildGeometry(const BuildOptions& options);
 
-  io::SceneDesc desc_;
+  io::CameraDesc cameraDesc_;
   Camera camera_;
   std::vector<Material> materials_;
   std::vector<Shape> shapes_;
