@@ -1,5 +1,7 @@
 #include "scene/occluders.h"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -10,6 +12,8 @@ using io::ShapeKind;
 namespace detail {
 
 constexpr uint32_t kLeafPieces = 4;
+// Splits of at least this many pieces build their halves in parallel.
+constexpr uint32_t kParallelPieces = 1u << 14;
 
 // Pads an extent for the rounding of the float values it was computed from.
 inline void pad(float& lo, float& hi) {
@@ -186,6 +190,7 @@ struct Hull {
 
 using detail::Hull;
 using detail::kLeafPieces;
+using detail::kParallelPieces;
 using detail::pad;
 
 OccluderIndex::OccluderIndex(const std::vector<Shape>& shapes, const std::vector<Mesh>& meshes)
@@ -242,9 +247,8 @@ OccluderIndex::OccluderIndex(const std::vector<Shape>& shapes, const std::vector
   }
   std::vector<uint32_t> order(n);
   for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
-  nodes_.reserve(2 * n / kLeafPieces + 2);
-  nodes_.emplace_back();
-  build(0, 0, uint32_t(n), order, boxes, centres);
+  nodes_.resize(subtreeNodes(uint32_t(n)));
+  build(0, 1, 0, uint32_t(n), order, boxes, centres);
   std::vector<Piece> sorted(n);
   for (size_t i = 0; i < n; ++i) sorted[i] = pieces_[order[i]];
   pieces_.swap(sorted);
@@ -261,8 +265,11 @@ Bounds3 OccluderIndex::pieceBox(const Piece& p) const {
 }
 
 // Fills node `self` for the pieces order[begin, end): a leaf, or a split at the median
-// centre along the centres' longest axis into two children stored side by side.
-void OccluderIndex::build(uint32_t self, uint32_t begin, uint32_t end, std::vector<uint32_t>& order,
+// centre along the centres' longest axis into two children stored side by side at `below`
+// and below + 1, the left child's descendants after them and then the right child's. The
+// slots depend on the piece counts alone (subtreeNodes), so the halves of large splits are
+// built in parallel (2M triangles: about 1 s on one thread), into the same layout.
+void OccluderIndex::build(uint32_t self, uint32_t below, uint32_t begin, uint32_t end, std::vector<uint32_t>& order,
                           const std::vector<Bounds3>& boxes, const std::vector<Vec3>& centres) {
   Bounds3 box, cbox;
   for (uint32_t i = begin; i < end; ++i) {
@@ -276,19 +283,27 @@ void OccluderIndex::build(uint32_t self, uint32_t begin, uint32_t end, std::vect
     return;
   }
   Vec3 e = cbox.extent();
-  int axis = e.x >= e.y && e.x >= e.z ? 0 : e.y >= e.z ? 1 : 2;
-  uint32_t mid = begin + (end - begin) / 2;
+  const int axis = e.x >= e.y && e.x >= e.z ? 0 : e.y >= e.z ? 1 : 2;
+  const uint32_t mid = begin + (end - begin) / 2;
   std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end, [&](uint32_t a, uint32_t b) {
     float ca = centres[a][axis], cb = centres[b][axis];
     return ca < cb || (ca == cb && a < b);
   });
-  const uint32_t first = uint32_t(nodes_.size());
-  nodes_.emplace_back();
-  nodes_.emplace_back();
-  nodes_[self].first = first;
+  nodes_[self].first = below;
   nodes_[self].count = 0;
-  build(first, begin, mid, order, boxes, centres);
-  build(first + 1, mid, end, order, boxes, centres);
+  const uint32_t leftBelow = below + 2, rightBelow = leftBelow + subtreeNodes(mid - begin) - 1;
+  auto left = [&] { build(below, leftBelow, begin, mid, order, boxes, centres); };
+  auto right = [&] { build(below + 1, rightBelow, mid, end, order, boxes, centres); };
+  if (end - begin >= kParallelPieces) {
+    tbb::parallel_invoke(left, right);
+  } else {
+    left();
+    right();
+  }
+}
+
+uint32_t OccluderIndex::subtreeNodes(uint32_t count) {
+  return count <= kLeafPieces ? 1 : 1 + subtreeNodes(count / 2) + subtreeNodes(count - count / 2);
 }
 
 bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const {

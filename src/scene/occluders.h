@@ -74,8 +74,9 @@ class OccluderIndex {
   };
   Bounds3 pieceBox(const Piece& p) const;
   bool pieceApart(const detail::Hull& hull, const Piece& p, int skip) const;
-  void build(uint32_t self, uint32_t begin, uint32_t end, std::vector<uint32_t>& order,
+  void build(uint32_t self, uint32_t below, uint32_t begin, uint32_t end, std::vector<uint32_t>& order,
              const std::vector<Bounds3>& boxes, const std::vector<Vec3>& centres);
+  static uint32_t subtreeNodes(uint32_t count);  // nodes over `count` pieces
 
   const std::vector<Shape>* shapes_ = nullptr;
   const std::vector<Mesh>* meshes_ = nullptr;

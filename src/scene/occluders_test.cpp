@@ -3,6 +3,9 @@
 #include "scene/occluders.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <memory>
 
 #include "core/rng.h"
 #include "scene/scene.h"
@@ -203,6 +206,55 @@ TEST(OccluderIndex, HintKeepsTheBlockerAndTheAnswers) {
   EXPECT_EQ(hint, blocker);
   EXPECT_TRUE(s->occluders().clear(Vec3(31.5f, 0, -5), Vec3(31.4f, -0.1f, 4), Vec3(31.6f, 0.1f, 5), 1e-5f, 0, -1,
                                    &hint));
+}
+
+// A mesh of more triangles than kParallelPieces: its hierarchy is built in parallel, into
+// slots fixed by the piece counts. Its answers must be sound (no "clear" segment meets a
+// triangle) and the same whatever the number of threads that built it.
+TEST(OccluderIndex, ALargeMeshBuiltInParallelAnswersSoundlyAndAlike) {
+  Rng rng(5, 0);
+  io::SceneDesc d;
+  d.materials.emplace_back();
+  io::MeshDesc mesh;
+  for (int t = 0; t < 40000; ++t) {
+    Vec3 c = uniformIn(rng, Vec3(-50.0f), Vec3(50.0f));
+    for (int v = 0; v < 3; ++v) mesh.points.push_back(c + uniformIn(rng, Vec3(-0.4f), Vec3(0.4f)));
+    mesh.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+  }
+  d.meshes.push_back(mesh);
+  io::ObjectDesc mo = object(ShapeKind::Mesh, Mat4::identity());
+  mo.mesh = 0;
+  d.objects.push_back(mo);
+  std::unique_ptr<Scene> one, all;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = Scene::build(d);
+  }
+  all = Scene::build(d);
+  ASSERT_EQ(all->occluders().pieceCount(), 40000u);
+  int clear = 0, blocked = 0;
+  for (int q = 0; q < 2000; ++q) {
+    Vec3 apex = uniformIn(rng, Vec3(-50.0f), Vec3(50.0f));
+    Vec3 c = apex + uniformIn(rng, Vec3(-6.0f), Vec3(6.0f)), h = uniformIn(rng, Vec3(0.0f), Vec3(0.5f));
+    const bool answer = all->occluders().clear(apex, c - h, c + h, 1e-5f);
+    ASSERT_EQ(answer, one->occluders().clear(apex, c - h, c + h, 1e-5f)) << "query " << q;
+    if (!answer) {
+      ++blocked;
+      continue;
+    }
+    ++clear;
+    for (int k = 0; k < 24; ++k) {
+      Vec3 target = k < 8 ? Vec3((k & 1) ? c.x + h.x : c.x - h.x, (k & 2) ? c.y + h.y : c.y - h.y,
+                                 (k & 4) ? c.z + h.z : c.z - h.z)
+                          : uniformIn(rng, c - h, c + h);
+      Vec3 dir = target - apex;
+      float dist = length(dir);
+      if (!(dist > 0)) continue;
+      ASSERT_FALSE(all->occluded(apex, dir / dist, dist)) << "query " << q << ": called clear, but a segment meets a triangle";
+    }
+  }
+  EXPECT_GT(clear, 200);
+  EXPECT_GT(blocked, 200);
 }
 
 }  // namespace
