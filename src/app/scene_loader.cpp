@@ -20,7 +20,9 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
   auto t0 = Clock::now();
   io::SceneDesc desc;
   if (fileExtension(path) == "obj") {
-    desc = io::loadObjScene(path, o.limits, &out.objDescription);
+    ProgressBar bar("scene", o.quiet);
+    desc = io::loadObjScene(path, o.limits, &out.objDescription, [&](double f) { bar.update(f); });
+    bar.finish();
   } else {
     io::ParseOptions po;
     po.lenient = o.lenient;
@@ -42,7 +44,12 @@ LoadedScene loadScene(const std::string& path, const LoadOptions& o) {
   bo.linearizeSrgbTextures = o.linearizeSrgbTextures;
   bo.occluders = o.occluders;
   bo.planarFaces = o.planarFaces;
-  out.scene = scene::Scene::build(desc, bo);
+  {
+    ProgressBar bar("accel", o.quiet);
+    bo.progress = [&](double f) { bar.update(f); };
+    out.scene = scene::Scene::build(desc, bo);
+    bar.finish();
+  }
   out.accelSeconds = since(t1);
 
   auto t2 = Clock::now();

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/limits.h"
+#include "core/progress.h"
 #include "io/scene_desc.h"
 
 namespace lc::io {
@@ -20,13 +21,15 @@ struct ObjData {
 // Loads `path`. `referredFrom` is the location of the `obj_mesh` that named it (or empty)
 // so that a missing file is reported where it was asked for. `base` is the material that
 // MTL materials start from (the current default material in a .ray file).
+// `progress` (core/progress.h), when given, is told the share of the file parsed.
 ObjData loadObj(const std::string& path, const SourceLoc& referredFrom, const MaterialDesc& base,
-                const Limits& limits);
+                const Limits& limits, const ProgressFn& progress = {});
 
 // A whole scene from an OBJ file: the mesh, its materials, and, because an OBJ brings
 // neither, a default camera framing its bounds and a default light rig. `description`
 // receives the camera and lights in .ray syntax so a user can copy them.
-SceneDesc loadObjScene(const std::string& path, const Limits& limits, std::string* description);
+SceneDesc loadObjScene(const std::string& path, const Limits& limits, std::string* description,
+                       const ProgressFn& progress = {});
 
 // Writes a .ray equivalent of an OBJ scene (obj2ray).
 void writeRayFromObj(const std::string& objPath, const std::string& outPath, const Limits& limits);

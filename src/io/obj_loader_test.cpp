@@ -703,5 +703,36 @@ TEST(ObjLoader, HugePolygonIsRefusedQuickly) {
   EXPECT_EQ(errorOf([&] { load(dir.file("ok.obj")); }), "");
 }
 
+// An OBJ of several megabytes reaches tinyobj a block at a time (no copy of the text): every
+// vertex and face arrives, and the progress it reports rises from 0 to 1.
+TEST(ObjLoader, ALargeFileLoadsWholeAndReportsItsProgress) {
+  TempDir dir;
+  const std::string path = dir.file("grid.obj");
+  constexpr int n = 300;  // 301^2 vertices, 2 * 300^2 triangles: about 4 MB of text
+  {
+    std::ofstream out(path);
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) out << "v " << i * 0.01 << " " << (i * j % 7) * 0.001 << " " << j * 0.01 << "\n";
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const int a = j * (n + 1) + i + 1;
+        out << "f " << a << " " << a + 1 << " " << a + n + 2 << "\nf " << a << " " << a + n + 2 << " " << a + n + 1
+            << "\n";
+      }
+  }
+  ASSERT_GT(std::filesystem::file_size(path), 3u << 20);
+  std::vector<double> seen;
+  const ObjData d = loadObj(path, SourceLoc{}, MaterialDesc{}, Limits{}, [&](double f) { seen.push_back(f); });
+  EXPECT_EQ(d.mesh.points.size(), size_t(n + 1) * size_t(n + 1));
+  ASSERT_EQ(d.mesh.triangles.size(), size_t(2 * n * n));
+  // The last face, as written.
+  const int a = (n - 1) * (n + 1) + (n - 1);  // 0-based
+  EXPECT_EQ(d.mesh.triangles.back()[1], a + n + 2);
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.front(), 0.0);
+  EXPECT_EQ(seen.back(), 1.0);
+  for (size_t i = 1; i < seen.size(); ++i) EXPECT_GE(seen[i], seen[i - 1]);
+}
+
 }  // namespace
 }  // namespace lc::io

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/limits.h"
+#include "core/progress.h"
 #include "io/scene_desc.h"
 #include "scene/camera.h"
 #include "scene/environment.h"
@@ -55,6 +56,9 @@ struct BuildOptions {
   // probes ask whether they hide a cluster. About 4 bytes per triangle and 100 per face;
   // the CLI leaves them out where nothing will ask (brute force, --visibility-probes off).
   bool planarFaces = true;
+  // Told how far the build is (core/progress.h): meshes, Embree's hierarchy, the occluder
+  // index and the planar faces (a 2M-triangle mesh takes over a second).
+  ProgressFn progress = {};
 };
 
 class Scene {
