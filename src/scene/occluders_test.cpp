@@ -22,6 +22,38 @@ Vec3 uniformIn(Rng& rng, const Vec3& lo, const Vec3& hi) {
   return lo + (hi - lo) * Vec3(rng.uniform(), rng.uniform(), rng.uniform());
 }
 
+// Adds to d one mesh object of `count` random triangles, each with its corners within
+// `size` of a centre in [-spread, spread]^3.
+void addRandomTriangles(io::SceneDesc& d, Rng& rng, int count, float spread, float size) {
+  io::MeshDesc mesh;
+  for (int t = 0; t < count; ++t) {
+    Vec3 c = uniformIn(rng, Vec3(-spread), Vec3(spread));
+    for (int v = 0; v < 3; ++v) mesh.points.push_back(c + uniformIn(rng, Vec3(-size), Vec3(size)));
+    mesh.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
+  }
+  io::ObjectDesc mo = object(ShapeKind::Mesh, Mat4::identity());
+  mo.mesh = int(d.meshes.size());
+  d.meshes.push_back(std::move(mesh));
+  d.objects.push_back(mo);
+}
+
+// Whether a "clear" answer holds: the segments from the apex to the box's corners and to
+// `samples - 8` random points in it, each stopping `shortfall` short, meet no surface.
+::testing::AssertionResult segmentsClear(const Scene& s, Rng& rng, const Vec3& apex, const Vec3& c, const Vec3& h,
+                                         float shortfall, int samples) {
+  for (int k = 0; k < samples; ++k) {
+    Vec3 target = k < 8 ? Vec3((k & 1) ? c.x + h.x : c.x - h.x, (k & 2) ? c.y + h.y : c.y - h.y,
+                               (k & 4) ? c.z + h.z : c.z - h.z)
+                        : uniformIn(rng, c - h, c + h);
+    Vec3 dir = target - apex;
+    float dist = length(dir);
+    if (!(dist > shortfall)) continue;
+    if (s.occluded(apex, dir / dist, dist - shortfall))
+      return ::testing::AssertionFailure() << "called clear, but a segment meets a surface";
+  }
+  return ::testing::AssertionSuccess();
+}
+
 // Random scenes: a few shapes of every kind under random rotations and scales, and a
 // mesh of random triangles; random apexes and boxes. Every "clear" is checked with rays
 // to the box's corners and random points in it; enough answers must be "clear" for the
@@ -39,16 +71,7 @@ TEST(OccluderIndex, ClearSegmentsMeetNoSurface) {
                Mat4::scale(0.3 + rng.uniform(), 0.3 + rng.uniform(), 0.3 + rng.uniform());
       d.objects.push_back(object(ShapeKind(k % 5), m));
     }
-    io::MeshDesc mesh;
-    for (int t = 0; t < 6; ++t) {
-      Vec3 c = uniformIn(rng, Vec3(-4.0f), Vec3(4.0f));
-      for (int v = 0; v < 3; ++v) mesh.points.push_back(c + uniformIn(rng, Vec3(-1.0f), Vec3(1.0f)));
-      mesh.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
-    }
-    d.meshes.push_back(mesh);
-    io::ObjectDesc mo = object(ShapeKind::Mesh, Mat4::identity());
-    mo.mesh = 0;
-    d.objects.push_back(mo);
+    addRandomTriangles(d, rng, 6, 4.0f, 1.0f);
     auto s = Scene::build(d);
     const OccluderIndex& index = s->occluders();
     ASSERT_EQ(index.pieceCount(), 6u + 6u);
@@ -61,16 +84,7 @@ TEST(OccluderIndex, ClearSegmentsMeetNoSurface) {
         continue;
       }
       ++clear;
-      for (int k = 0; k < 72; ++k) {
-        Vec3 target = k < 8 ? Vec3((k & 1) ? c.x + h.x : c.x - h.x, (k & 2) ? c.y + h.y : c.y - h.y,
-                                   (k & 4) ? c.z + h.z : c.z - h.z)
-                            : uniformIn(rng, c - h, c + h);
-        Vec3 dir = target - apex;
-        float dist = length(dir);
-        if (!(dist > shortfall)) continue;
-        ASSERT_FALSE(s->occluded(apex, dir / dist, dist - shortfall))
-            << "scene " << sceneIndex << " query " << q << ": called clear, but a segment meets a surface";
-      }
+      ASSERT_TRUE(segmentsClear(*s, rng, apex, c, h, shortfall, 72)) << "scene " << sceneIndex << " query " << q;
     }
   }
   EXPECT_GT(clear, 300);
@@ -215,16 +229,7 @@ TEST(OccluderIndex, ALargeMeshBuiltInParallelAnswersSoundlyAndAlike) {
   Rng rng(5, 0);
   io::SceneDesc d;
   d.materials.emplace_back();
-  io::MeshDesc mesh;
-  for (int t = 0; t < 40000; ++t) {
-    Vec3 c = uniformIn(rng, Vec3(-50.0f), Vec3(50.0f));
-    for (int v = 0; v < 3; ++v) mesh.points.push_back(c + uniformIn(rng, Vec3(-0.4f), Vec3(0.4f)));
-    mesh.triangles.push_back({3 * t, 3 * t + 1, 3 * t + 2});
-  }
-  d.meshes.push_back(mesh);
-  io::ObjectDesc mo = object(ShapeKind::Mesh, Mat4::identity());
-  mo.mesh = 0;
-  d.objects.push_back(mo);
+  addRandomTriangles(d, rng, 40000, 50.0f, 0.4f);
   std::unique_ptr<Scene> one, all;
   {
     tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
@@ -243,15 +248,7 @@ TEST(OccluderIndex, ALargeMeshBuiltInParallelAnswersSoundlyAndAlike) {
       continue;
     }
     ++clear;
-    for (int k = 0; k < 24; ++k) {
-      Vec3 target = k < 8 ? Vec3((k & 1) ? c.x + h.x : c.x - h.x, (k & 2) ? c.y + h.y : c.y - h.y,
-                                 (k & 4) ? c.z + h.z : c.z - h.z)
-                          : uniformIn(rng, c - h, c + h);
-      Vec3 dir = target - apex;
-      float dist = length(dir);
-      if (!(dist > 0)) continue;
-      ASSERT_FALSE(all->occluded(apex, dir / dist, dist)) << "query " << q << ": called clear, but a segment meets a triangle";
-    }
+    ASSERT_TRUE(segmentsClear(*all, rng, apex, c, h, 0.0f, 24)) << "query " << q;
   }
   EXPECT_GT(clear, 200);
   EXPECT_GT(blocked, 200);
