@@ -30,7 +30,7 @@ std::string Token::describe() const {
     case TokenKind::Ident:
       return quoted ? "string \"" + escapeInput(text) + "\"" : quoteInput(text);
     case TokenKind::Number:
-      return "number " + text;
+      return "number " + std::string(text);
     case TokenKind::Bool:
       return quoteInput(text);
     case TokenKind::Punct:
@@ -41,12 +41,12 @@ std::string Token::describe() const {
   return "end of file";
 }
 
-std::string canonicalKeyword(std::string_view w) {
+std::string_view canonicalKeyword(std::string_view w) {
   if (w == "colour") return "color";
   if (w == "polymesh") return "trimesh";
   if (w == "quaternian") return "quaternion";
   if (w == "texcoords" || w == "tex_coords") return "texture_uv";
-  return std::string(w);
+  return w;
 }
 
 RayLexer::RayLexer(std::string_view text, std::string file) : text_(text), file_(std::move(file)) {
@@ -124,7 +124,7 @@ void RayLexer::scan(Token& t) {
     if (pos_ >= text_.size() || text_[pos_] != '"') fail(t.line, t.column, "unterminated string");
     t.kind = TokenKind::Ident;
     t.quoted = true;
-    t.text = std::string(text_.substr(start, pos_ - start));
+    t.text = text_.substr(start, pos_ - start);
     t.word = t.text;
     advance();
     return;
@@ -133,7 +133,7 @@ void RayLexer::scan(Token& t) {
   if (isIdentStart(c)) {
     size_t start = pos_;
     while (isIdentChar(at(pos_))) advance();
-    t.text = std::string(text_.substr(start, pos_ - start));
+    t.text = text_.substr(start, pos_ - start);
     if (t.text == "true" || t.text == "false") {
       t.kind = TokenKind::Bool;
       t.boolean = t.text == "true";
@@ -166,7 +166,7 @@ void RayLexer::scan(Token& t) {
     // "1abc", "1e", "1.2.3": a number glued to more word characters is malformed.
     size_t end = p;
     while (isIdentStart(at(end)) || isDigit(at(end)) || at(end) == '.') ++end;
-    std::string spelled(text_.substr(start, end - start));
+    const std::string_view spelled = text_.substr(start, end - start);
     if (end != p) fail(t.line, t.column, "malformed number " + quoteInput(spelled) + "");
     while (pos_ < p) advance();
 
@@ -178,7 +178,7 @@ void RayLexer::scan(Token& t) {
     if (ec == std::errc::result_out_of_range) {
       // Overflow is an error; underflow reads as the nearest representable value.
       errno = 0;
-      v = std::strtod(b, nullptr);
+      v = std::strtod(std::string(b, e).c_str(), nullptr);  // strtod reads to a terminator
       if (std::isinf(v)) fail(t.line, t.column, "number " + quoteInput(spelled) + " is out of range");
     } else if (ec != std::errc() || ptr != e) {
       fail(t.line, t.column, "malformed number " + quoteInput(spelled) + "");

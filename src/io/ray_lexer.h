@@ -20,8 +20,10 @@ enum class TokenKind {
 
 struct Token {
   TokenKind kind = TokenKind::End;
-  std::string text;    // as written (without the quotes of a string)
-  std::string word;    // identifiers: the canonical spelling (aliases folded: colour -> color)
+  // Views into the lexer's text, which outlives the tokens, or for a folded alias a
+  // literal: a token allocates nothing (a scene of 2M point lights has 50M of them).
+  std::string_view text;  // as written (without the quotes of a string)
+  std::string_view word;  // identifiers: the canonical spelling (aliases folded: colour -> color)
   bool quoted = false; // identifier came from "..."
   double number = 0;   // Number
   bool boolean = false;  // Bool
@@ -36,7 +38,7 @@ struct Token {
 
 // The canonical spelling of a keyword: `colour` -> `color`, `polymesh` -> `trimesh`,
 // `quaternian` -> `quaternion`, `texcoords`/`tex_coords` -> `texture_uv`; others unchanged.
-std::string canonicalKeyword(std::string_view word);
+std::string_view canonicalKeyword(std::string_view word);
 
 class RayLexer {
  public:

@@ -3,13 +3,19 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
+#include <string>
 #include <vector>
 
 namespace lc::io {
 namespace {
 
+// Tokens are views of the text they were read from: the texts lexed here are kept for the
+// test's lifetime, as the parser keeps its file's while it parses.
 std::vector<Token> lexAll(const std::string& text) {
-  RayLexer lex(text, "t.ray");
+  static std::vector<std::unique_ptr<std::string>> kept;
+  kept.push_back(std::make_unique<std::string>(text));
+  RayLexer lex(*kept.back(), "t.ray");
   std::vector<Token> out;
   for (;;) {
     Token t = lex.next();

@@ -63,9 +63,15 @@ void appendObjMesh(SceneDesc& scene, ObjData&& obj, ObjectDesc object,
 
 namespace {
 
+// Tokens hold views of the text (ray_lexer.h); messages join them to strings.
+std::string operator+(std::string a, std::string_view b) { return a.append(b); }
+std::string operator+(std::string_view a, const std::string& b) { return std::string(a).append(b); }
+std::string operator+(const char* a, std::string_view b) { return std::string(a).append(b); }
+std::string operator+(std::string_view a, const char* b) { return std::string(a).append(b); }
+
 std::string quoteChar(char c) { return std::string("'") + c + "'"; }
 
-bool oneOf(const std::string& w, std::initializer_list<const char*> words) {
+bool oneOf(std::string_view w, std::initializer_list<const char*> words) {
   for (const char* x : words)
     if (w == x) return true;
   return false;
@@ -78,14 +84,14 @@ bool isTransformWord(const Token& t) {
 
 bool isPrimitiveWord(const Token& t) {
   if (t.kind != TokenKind::Ident || t.quoted) return false;
-  const std::string& w = t.word;
+  const std::string_view w = t.word;
   return w == "sphere" || w == "box" || w == "square" || w == "cylinder" || w == "cone" ||
          w == "trimesh" || w == "obj_mesh" || w == "sphere_light";
 }
 
 bool isTopLevelOnlyWord(const Token& t) {
   if (t.kind != TokenKind::Ident || t.quoted) return false;
-  const std::string& w = t.word;
+  const std::string_view w = t.word;
   return w == "camera" || w == "ambient_light" || w == "point_light" || w == "directional_light" ||
          w == "spot_light" || w == "area_light" || w == "instant_radiosity" || w == "environment_light" ||
          w == "sun_sky_light";
@@ -128,7 +134,7 @@ class Parser {
     return std::to_string(t.line) + ":" + std::to_string(t.column);
   }
   // An unknown attribute or item: an error, or with --lenient a warning and its value skipped.
-  void unknown(const Token& key, const std::string& context);
+  void unknown(const Token& key, std::string_view context);
   void skipValue();
 
   // ---- tokens and values ----------------------------------------------------------------
@@ -188,7 +194,7 @@ class Parser {
   // "( item, item, ... )" calling item() for each entry.
   void list(const std::function<void()>& item);
   template <class F>
-  void block(const std::string& what, F&& onAttr);
+  void block(std::string_view what, F&& onAttr);
 
   ColorParam colorValue();
   ScalarParam scalarValue();
@@ -333,7 +339,7 @@ TextureRef Parser::mapValue(const Token& mapKeyword) {
   if (f.text.empty()) fail(f, "empty texture file name");
   expectPunct(')');
   TextureRef ref;
-  ref.path = resolveRelative(baseDir_, f.text);
+  ref.path = resolveRelative(baseDir_, std::string(f.text));
   ref.loc = lex_.loc(mapKeyword);
   ref.srgb = false;  // scalar maps (shininess, index) are values; colour maps are marked below
   return ref;
@@ -368,7 +374,7 @@ ScalarParam Parser::scalarValue() {
 // "{ key ... }": calls onAttr(key) for each attribute name; onAttr reads the value and
 // returns false for a key it does not know. Semicolons between attributes are optional.
 template <class F>
-void Parser::block(const std::string& what, F&& onAttr) {
+void Parser::block(std::string_view what, F&& onAttr) {
   Token open = lex_.next();
   if (!open.isPunct('{')) expected("'{' after " + what, open);
   for (;;) {
@@ -389,7 +395,7 @@ void Parser::block(const std::string& what, F&& onAttr) {
   }
 }
 
-void Parser::unknown(const Token& key, const std::string& context) {
+void Parser::unknown(const Token& key, std::string_view context) {
   std::string msg = "unknown keyword " + quoteInput(key.text) + "";
   if (!context.empty()) msg += " in " + context;
   if (!opt_.lenient) fail(key, msg);
@@ -468,7 +474,7 @@ SceneDesc Parser::run() {
       continue;
     }
     if (t.kind != TokenKind::Ident) expected("a scene item (camera, light, material or object)", lex_.next());
-    const std::string w = t.quoted ? std::string() : t.word;
+    const std::string_view w = t.quoted ? std::string_view() : t.word;
     if (w == "material") {
       materialDecl();
       continue;
@@ -511,7 +517,7 @@ int Parser::materialValue(int baseIndex) {
   if (t.isPunct('{')) return materialBlock(baseIndex);
   if (t.kind == TokenKind::Ident) {
     Token n = lex_.next();
-    auto it = named_.find(n.text);
+    auto it = named_.find(std::string(n.text));
     if (it == named_.end()) fail(n, "unknown material " + quoteInput(n.text) + "");
     return it->second;
   }
@@ -539,7 +545,7 @@ int Parser::materialBlock(int baseIndex) {
   bool haveDiffuse = false;
   std::optional<ColorParam> albedo;
   block("material", [&](const Token& k) {
-    const std::string& w = k.word;
+    const std::string_view w = k.word;
     auto colour = [&](ColorParam& c) {
       expectEquals();
       c = colorValue();
@@ -559,7 +565,7 @@ int Parser::materialBlock(int baseIndex) {
       expectEquals();
       applyEmission(m, emissionValue(), k);
     } else if (oneOf(w, {"type", "metallic", "roughness", "translucency"})) {
-      ++ignoredPbr_[w];
+      ++ignoredPbr_[std::string(w)];
       if (!firstPbr_) firstPbr_ = lex_.loc(k);
       skipValue();
     } else if (w == "specular") {
@@ -580,9 +586,9 @@ int Parser::materialBlock(int baseIndex) {
       (w == "shininess" ? m.shininess : m.index) = s;
     } else if (w == "name") {
       Token at = nameValue();
-      const std::string& n = at.text;
+      const std::string_view n = at.text;
       if (!n.empty()) {
-        auto it = named_.find(n);
+        auto it = named_.find(std::string(n));
         if (it != named_.end())
           fail(at, "material " + quoteInput(n) + " is already declared (at " +
                        scene_.materials[size_t(it->second)].loc.str() + ")");
@@ -613,7 +619,7 @@ LuminosityDesc Parser::luminosity(const Token& key) {
   LuminosityDesc l;
   l.loc = lex_.loc(key);
   block("luminosity", [&](const Token& k) {
-    const std::string& w = k.word;
+    const std::string_view w = k.word;
     if (!oneOf(w, {"color", "intensity", "density", "per_area", "constant_attenuation_coeff",
                    "linear_attenuation_coeff", "quadratic_attenuation_coeff"}))
       return false;
@@ -667,7 +673,7 @@ void Parser::camera(const Token& kw) {
   bool haveLookAt = false;
   Token viewTok = kw, upTok = kw, lookTok;
   block("camera", [&](const Token& k) {
-    const std::string& w = k.word;
+    const std::string_view w = k.word;
     if (!oneOf(w, {"position", "viewdir", "updir", "look_at", "quaternion", "fov", "aspectratio"}))
       return false;
     expectEquals();
@@ -702,7 +708,7 @@ void Parser::camera(const Token& kw) {
       float f = toFloat(t);
       if (!(f > 0 && f < 180)) {
         // Say so when the text is in range but its float is not (179.99999999 is 180.0f).
-        std::string got = t.text;
+        std::string got(t.text);
         if (double(f) != t.number) {
           char buf[32];
           std::string fs(buf, std::to_chars(buf, buf + sizeof buf, f).ptr);
@@ -769,7 +775,7 @@ void Parser::addLight(LightDesc&& l, const Token& kw) {
 // (point and spot lights); a light that sets none of the three takes --default-attenuation
 // when given. The last of direction / target decides the spot axis.
 void Parser::light(const Token& kw) {
-  const std::string kind = kw.word;
+  const std::string_view kind = kw.word;
   LightDesc l;
   l.kind = kind == "point_light" ? LightKind::Point
            : kind == "spot_light" ? LightKind::Spot
@@ -782,7 +788,7 @@ void Parser::light(const Token& kw) {
   Token targetTok, blendTok;
   bool anyAtten = false;
   block(kind, [&](const Token& k) {
-    const std::string& w = k.word;
+    const std::string_view w = k.word;
     if (w == "color") {
       expectEquals();
       l.colour = vec3();
@@ -872,7 +878,7 @@ void Parser::areaLight(const Token& kw) {
   Color colour(1, 1, 1);
   bool haveU = false, haveV = false;
   block("area_light", [&](const Token& k) {
-    const std::string& w = k.word;
+    const std::string_view w = k.word;
     if (w != "position" && w != "u" && w != "v" && w != "color") return false;
     expectEquals();
     Vec3 x = w == "color" ? vec3() : coord();
@@ -939,7 +945,7 @@ void Parser::instantRadiosity(const Token& kw) {
   InstantRadiosityDesc ir = scene_.instantRadiosity.value_or(InstantRadiosityDesc{});
   ir.loc = lex_.loc(kw);
   block("instant_radiosity", [&](const Token& k) {
-    const std::string& w = k.word;
+    const std::string_view w = k.word;
     if (!oneOf(w, {"vpls", "bounces", "normalize", "clamp", "seed", "caustics", "caustic_lights"})) return false;
     expectEquals();
     if (w == "vpls") {
@@ -996,7 +1002,7 @@ void Parser::environmentLight(const Token& kw) {
   e.kind = EnvironmentKind::Map;
   e.loc = lex_.loc(kw);
   block("environment_light", [&](const Token& k) {
-    const std::string& w = k.word;
+    const std::string_view w = k.word;
     if (!oneOf(w, {"map", "color", "intensity", "up", "rotate", "lights", "visible"})) return false;
     expectEquals();
     if (w == "map") {
@@ -1004,7 +1010,7 @@ void Parser::environmentLight(const Token& kw) {
       if (f.kind != TokenKind::Ident) expected("a file name (\"sky.hdr\")", f);
       if (f.text.empty()) fail(f, "empty environment map file name");
       TextureRef ref;
-      ref.path = resolveRelative(baseDir_, f.text);
+      ref.path = resolveRelative(baseDir_, std::string(f.text));
       ref.loc = lex_.loc(f);
       ref.srgb = true;  // 8-bit maps are sRGB-encoded; .hdr and .exr stay linear
       e.map = ref;
@@ -1047,7 +1053,7 @@ void Parser::sunSkyLight(const Token& kw) {
   e.kind = EnvironmentKind::SunSky;
   e.loc = lex_.loc(kw);
   block("sun_sky_light", [&](const Token& k) {
-    const std::string& w = k.word;
+    const std::string_view w = k.word;
     if (!oneOf(w, {"direction", "turbidity", "intensity", "lights", "ground", "visible"})) return false;
     expectEquals();
     if (w == "direction") {
@@ -1087,7 +1093,7 @@ void Parser::pushFrame(bool group, const Mat4& xf, const Token& open) {
   if (int(frames_.size()) >= opt_.limits.maxNesting)
     fail(open, "nesting deeper than the limit of " + std::to_string(opt_.limits.maxNesting) +
                    " levels (raise it with --max-nesting)");
-  frames_.push_back(Frame{group, xf, defaultMat_, group ? "group" : open.text, open.line, open.column});
+  frames_.push_back(Frame{group, xf, defaultMat_, group ? std::string("group") : std::string(open.text), open.line, open.column});
 }
 
 // node := primitive | transform | "{" { node | material_decl | ";" } "}"
@@ -1164,7 +1170,7 @@ bool Parser::closeFrames() {
 //            | "transform" "(" row "," row "," row "," row ","   4x4 row-major, last row 0 0 0 1
 // followed by the child node and ")". Reads up to and including the ',' before the child.
 Mat4 Parser::transformArgs(const Token& kw) {
-  const std::string& w = kw.word;
+  const std::string_view w = kw.word;
   expectPunct('(');
   auto arg = [&](Token* tok = nullptr) {
     Token t = numberToken();
@@ -1230,7 +1236,7 @@ void Parser::primitive(const Token& kw) {
   obj.transform = currentTransform();
   obj.material = defaultMat_;
   obj.loc = lex_.loc(kw);
-  const std::string& w = kw.word;
+  const std::string_view w = kw.word;
   if (w == "trimesh") return trimesh(kw, obj);
   if (w == "obj_mesh") return objMesh(kw, obj);
   if (w == "sphere_light") return sphereLight(kw, obj);
@@ -1243,7 +1249,7 @@ void Parser::primitive(const Token& kw) {
   std::optional<Color> emission;
   Token emissionTok;
   block(kw.text, [&](const Token& k) {
-    const std::string& a = k.word;
+    const std::string_view a = k.word;
     if (a == "material") {
       expectEquals();
       obj.material = materialValue(defaultMat_);
@@ -1323,7 +1329,7 @@ void Parser::sphereLight(const Token& kw, ObjectDesc& obj) {
   float radius = 1;
   Token radiusTok = kw;
   block("sphere_light", [&](const Token& k) {
-    const std::string& a = k.word;
+    const std::string_view a = k.word;
     if (a == "emission") {
       expectEquals();
       emissionTok = k;
@@ -1399,7 +1405,7 @@ void Parser::trimesh(const Token& kw, ObjectDesc& obj) {
   std::optional<Color> emission;
   Token emissionTok;
   block(kw.text, [&](const Token& k) {
-    const std::string& a = k.word;
+    const std::string_view a = k.word;
     if (a == "material") {
       expectEquals();
       obj.material = materialValue(defaultMat_);
@@ -1512,7 +1518,7 @@ void Parser::objMesh(const Token& kw, ObjectDesc& obj) {
   std::optional<Color> emission;
   Token emissionTok;
   block("obj_mesh", [&](const Token& k) {
-    const std::string& a = k.word;
+    const std::string_view a = k.word;
     if (a == "file") {
       expectEquals();
       Token f = lex_.next();
