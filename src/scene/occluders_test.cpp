@@ -222,6 +222,47 @@ TEST(OccluderIndex, HintKeepsTheBlockerAndTheAnswers) {
                                    &hint));
 }
 
+// Any piece as the hint, the answer is the one without a hint. A hinted quadric is first
+// asked whether a segment toward a corner of the box runs through its bounds (a "no" before
+// the hull is set up); random scenes of every shape kind, rotated and scaled, with random
+// apexes, boxes, shortfalls and skipped shapes, check that it never says no where the full
+// test says clear, and that it is asked often enough to matter.
+TEST(OccluderIndex, AHintNeverChangesTheAnswer) {
+  Rng rng(33, 0);
+  int clear = 0, blocked = 0;
+  for (int sceneIndex = 0; sceneIndex < 8; ++sceneIndex) {
+    io::SceneDesc d;
+    d.materials.emplace_back();
+    for (int k = 0; k < 10; ++k) {
+      Vec3 c = uniformIn(rng, Vec3(-3.0f), Vec3(3.0f));
+      Mat4 m = Mat4::translate(c.x, c.y, c.z) *
+               (k % 2 ? Mat4::rotate(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5, 6.28 * rng.uniform())
+                      : Mat4::identity()) *
+               Mat4::scale(0.2 + rng.uniform(), 0.2 + rng.uniform(), 0.2 + rng.uniform());
+      d.objects.push_back(object(ShapeKind(k % 5), m));
+    }
+    addRandomTriangles(d, rng, 4, 3.0f, 1.0f);
+    auto s = Scene::build(d);
+    const OccluderIndex& index = s->occluders();
+    for (int q = 0; q < 200; ++q) {
+      Vec3 apex = uniformIn(rng, Vec3(-5.0f), Vec3(5.0f));
+      Vec3 c = uniformIn(rng, Vec3(-5.0f), Vec3(5.0f)), h = uniformIn(rng, Vec3(0.0f), Vec3(1.0f));
+      if (q % 7 == 0) h.y = 0;  // flat boxes too
+      const float shortfall = q % 3 == 0 ? 0.0f : q % 3 == 1 ? 0.01f : 0.5f;
+      const int skip = q % 5 == 0 ? int(rng.uniform() * 10) : -1;
+      const bool expected = index.clear(apex, c - h, c + h, 1e-5f, shortfall, skip);
+      (expected ? clear : blocked) += 1;
+      for (uint32_t piece = 0; piece < index.pieceCount(); ++piece) {
+        uint32_t hint = piece;
+        ASSERT_EQ(index.clear(apex, c - h, c + h, 1e-5f, shortfall, skip, &hint), expected)
+            << "scene " << sceneIndex << " query " << q << " hint " << piece;
+      }
+    }
+  }
+  EXPECT_GT(clear, 100);
+  EXPECT_GT(blocked, 400);
+}
+
 // A mesh of more triangles than kParallelPieces: its hierarchy is built in parallel, into
 // slots fixed by the piece counts. Its answers must be sound (no "clear" segment meets a
 // triangle) and the same whatever the number of threads that built it.
