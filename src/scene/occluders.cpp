@@ -344,7 +344,8 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
 // A point X of a segment of the query inside the piece's bounding box (and, for a rotated
 // quadric, within its extent along each of its axes) lies on both sides of every plane and
 // cone pieceApart could separate them by, so pieceApart answers no. The segments toward the
-// box's eight corners are clipped to the piece's box four at a time (slabs, in SSE lanes);
+// box's eight corners are clipped to the piece's box (and a rotated quadric's own slabs) four
+// at a time (in SSE lanes);
 // a segment that keeps a part is checked at that part's midpoint, as computed, so that no
 // rounding of the clipping makes a witness of a point outside. Each segment ends at most
 // `shortfall` short of its corner: by the largest of |d|'s components, not its length, which
@@ -354,6 +355,11 @@ bool OccluderIndex::quadricOnSegments(const Vec3& apex, const Vec3& lo, const Ve
   if (int(p.shape) == skip || (*shapes_)[p.shape].kind == ShapeKind::Mesh) return false;
   const QuadricAxes& q = quadrics_[p.shape];
   const Bounds3& b = q.box;
+  // Every segment lies in the box around the apex and the query's box: a piece outside it
+  // has no point on them (and pieceApart will say so at once).
+  const Vec3 slo = vmin(apex, lo), shi = vmax(apex, hi);
+  if (b.hi.x < slo.x || b.lo.x > shi.x || b.hi.y < slo.y || b.lo.y > shi.y || b.hi.z < slo.z || b.lo.z > shi.z)
+    return false;
   auto inside = [&](const Vec3& x) {
     if (!(x.x >= b.lo.x && x.x <= b.hi.x && x.y >= b.lo.y && x.y <= b.hi.y && x.z >= b.lo.z && x.z <= b.hi.z))
       return false;
@@ -386,6 +392,13 @@ bool OccluderIndex::quadricOnSegments(const Vec3& apex, const Vec3& lo, const Ve
     slab(dx, apex.x, b.lo.x, b.hi.x);
     slab(dy, apex.y, b.lo.y, b.hi.y);
     slab(dz, apex.z, b.lo.z, b.hi.z);
+    // A rotated quadric: its own slabs too (along its axes: d's and the apex's components).
+    for (int k = 0; k < q.axes; ++k) {
+      const Vec3& n = q.axis[k];
+      const __m128 dn = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, _mm_set1_ps(n.x)), _mm_mul_ps(dy, _mm_set1_ps(n.y))),
+                                   _mm_mul_ps(dz, _mm_set1_ps(n.z)));
+      slab(dn, dot(n, apex), q.lo[k], q.hi[k]);
+    }
     int hits = _mm_movemask_ps(_mm_cmple_ps(t0, t1));
     if (!hits) continue;
     _mm_store_ps(t0s, t0);
@@ -399,13 +412,15 @@ bool OccluderIndex::quadricOnSegments(const Vec3& apex, const Vec3& lo, const Ve
     const Vec3 d = corner(k) - apex;
     const float m = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
     float t0 = 0, t1 = 1 - shortfall / m;
-    for (int a = 0; a < 3; ++a) {
-      const float ta = (b.lo[a] - apex[a]) / d[a], tb = (b.hi[a] - apex[a]) / d[a];
+    auto slab = [&](float dn, float a, float blo, float bhi) {
+      const float ta = (blo - a) / dn, tb = (bhi - a) / dn;
       if (!std::isnan(ta) && !std::isnan(tb)) {
         t0 = std::max(t0, std::min(ta, tb));
         t1 = std::min(t1, std::max(ta, tb));
       }
-    }
+    };
+    for (int a = 0; a < 3; ++a) slab(d[a], apex[a], b.lo[a], b.hi[a]);
+    for (int a = 0; a < q.axes; ++a) slab(dot(q.axis[a], d), dot(q.axis[a], apex), q.lo[a], q.hi[a]);
     if (witness(d, t0, t1)) return true;
   }
   return false;
