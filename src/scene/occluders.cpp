@@ -341,8 +341,8 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
   return hull.coneApart(b) || hull.triangleApart(v) || hull.silhouetteApart(b);
 }
 
-// A point X of a segment of the query inside the piece's bounding box (and, for a rotated
-// quadric, within its extent along each of its axes) lies on both sides of every plane and
+// A quadric: a point X of a segment of the query inside the piece's bounding box (and, for a
+// rotated quadric, within its extent along each of its axes) lies on both sides of every plane and
 // cone pieceApart could separate them by, so pieceApart answers no. The segments toward the
 // box's eight corners are clipped to the piece's box (and a rotated quadric's own slabs) four
 // at a time (in SSE lanes);
@@ -350,9 +350,44 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
 // rounding of the clipping makes a witness of a point outside. Each segment ends at most
 // `shortfall` short of its corner: by the largest of |d|'s components, not its length, which
 // ends it no later than its length would.
-bool OccluderIndex::quadricOnSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi, float shortfall,
-                                      const Piece& p, int skip) const {
-  if (int(p.shape) == skip || (*shapes_)[p.shape].kind == ShapeKind::Mesh) return false;
+bool OccluderIndex::onSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi, float margin, float shortfall,
+                               const Piece& p, int skip) const {
+  if (int(p.shape) == skip) return false;
+  auto corner = [&](int k) { return Vec3((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z); };
+  const Shape& shape = (*shapes_)[p.shape];
+  if (shape.kind == ShapeKind::Mesh) {
+    // A triangle: a segment that crosses it inside (by kInside of its barycentric
+    // coordinates, beyond their rounding), at a point within half the margin of the
+    // triangle's bounding box as computed (a flat triangle's box has no depth): the box,
+    // plane, cone, edge-plane and silhouette tests of pieceApart all have it on both sides.
+    constexpr float kInside = 1e-4f;
+    const Mesh& m = (*meshes_)[size_t(shape.mesh)];
+    const auto& tri = m.triangles[p.prim];
+    const Vec3 v0 = m.positions[size_t(tri[0])], v1 = m.positions[size_t(tri[1])], v2 = m.positions[size_t(tri[2])];
+    Bounds3 b(v0, v1);
+    b.extend(v2);
+    const Vec3 slo = vmin(apex, lo), shi = vmax(apex, hi);
+    if (b.hi.x < slo.x || b.lo.x > shi.x || b.hi.y < slo.y || b.lo.y > shi.y || b.hi.z < slo.z || b.lo.z > shi.z)
+      return false;
+    const Vec3 e1 = v1 - v0, e2 = v2 - v0, s0 = apex - v0, qv = cross(s0, e1);
+    const float slack = 0.5f * margin;
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 d = corner(k) - apex;
+      const float dm = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+      const Vec3 pv = cross(d, e2);
+      const float det = dot(e1, pv);
+      if (!(std::fabs(det) > 0) || !(dm > 0)) continue;
+      const float inv = 1 / det;
+      const float u = dot(s0, pv) * inv, v = dot(d, qv) * inv, t = dot(e2, qv) * inv;
+      if (!(u >= kInside && v >= kInside && u + v <= 1 - kInside && t >= kInside && t <= 1 - shortfall / dm - kInside))
+        continue;
+      const Vec3 x = apex + d * t;
+      if (x.x >= b.lo.x - slack && x.x <= b.hi.x + slack && x.y >= b.lo.y - slack && x.y <= b.hi.y + slack &&
+          x.z >= b.lo.z - slack && x.z <= b.hi.z + slack)
+        return true;
+    }
+    return false;
+  }
   const QuadricAxes& q = quadrics_[p.shape];
   const Bounds3& b = q.box;
   // Every segment lies in the box around the apex and the query's box: a piece outside it
@@ -370,7 +405,6 @@ bool OccluderIndex::quadricOnSegments(const Vec3& apex, const Vec3& lo, const Ve
     return true;
   };
   auto witness = [&](const Vec3& d, float t0, float t1) { return t0 <= t1 && inside(apex + d * (0.5f * (t0 + t1))); };
-  auto corner = [&](int k) { return Vec3((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z); };
 #if defined(__SSE2__)
   const __m128 one = _mm_set1_ps(1.0f), sf = _mm_set1_ps(shortfall), sign = _mm_set1_ps(-0.0f);
   alignas(16) float t0s[4], t1s[4];
@@ -433,11 +467,11 @@ bool OccluderIndex::clear(const Vec3& apex, const Vec3& lo, const Vec3& hi, floa
   if (nodes_.empty()) return true;
   // The piece that stopped the last query is often in the way of this one too (a pillar
   // between the point and a group of clusters): tried first, a "no" costs one piece. Most
-  // queries that reach it end there; for a quadric, one of a few segments of the query
-  // running through its bounds says so before the hull is set up (85% of such "no"s in a
-  // room of boxes, where the hull and the piece's full test cost ~5% of the render).
+  // queries that reach it end there; a segment toward a corner of the box running through
+  // it says so before the hull is set up (85% of such "no"s in a room of boxes, where the
+  // hull and the piece's full test cost ~5% of the render).
   const bool hinted = hint && *hint < pieces_.size();
-  if (hinted && quadricOnSegments(apex, lo, hi, shortfall, pieces_[*hint], skip)) return false;
+  if (hinted && onSegments(apex, lo, hi, margin, shortfall, pieces_[*hint], skip)) return false;
   const Hull hull(apex, lo, hi, margin, shortfall);
   if (hinted && !pieceApart(hull, pieces_[*hint], skip)) return false;
   uint32_t stack[64];

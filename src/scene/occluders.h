@@ -74,11 +74,11 @@ class OccluderIndex {
   };
   Bounds3 pieceBox(const Piece& p) const;
   bool pieceApart(const detail::Hull& hull, const Piece& p, int skip) const;
-  // Whether a segment of the query (from the apex toward the box's centre or a corner,
-  // ending `shortfall` before it) runs through what pieceApart tests of quadric piece p:
-  // then pieceApart would answer no, and the query is not clear.
-  bool quadricOnSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi, float shortfall, const Piece& p,
-                         int skip) const;
+  // Whether a segment of the query (from the apex toward a corner of the box, ending
+  // `shortfall` before it) runs through piece p as pieceApart sees it: then pieceApart would
+  // answer no, and the query is not clear. False says nothing.
+  bool onSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi, float margin, float shortfall, const Piece& p,
+                  int skip) const;
   void build(uint32_t self, uint32_t below, uint32_t begin, uint32_t end, std::vector<uint32_t>& order,
              const std::vector<Bounds3>& boxes, const std::vector<Vec3>& centres);
   static uint32_t subtreeNodes(uint32_t count);  // nodes over `count` pieces

@@ -222,11 +222,12 @@ TEST(OccluderIndex, HintKeepsTheBlockerAndTheAnswers) {
                                    &hint));
 }
 
-// Any piece as the hint, the answer is the one without a hint. A hinted quadric is first
-// asked whether a segment toward a corner of the box runs through its bounds (a "no" before
-// the hull is set up); random scenes of every shape kind, rotated and scaled, with random
-// apexes, boxes, shortfalls and skipped shapes, check that it never says no where the full
-// test says clear, and that it is asked often enough to matter.
+// Any piece as the hint, the answer is the one without a hint. A hinted piece is first
+// asked whether a segment toward a corner of the box runs through it (a "no" before the hull
+// is set up); random scenes of every shape kind, rotated and scaled, and random triangles,
+// with random apexes, boxes, shortfalls and skipped shapes, and boxes of lights lying on a
+// triangle (which the shortfall sets apart), check that it never says no where the full test
+// says clear.
 TEST(OccluderIndex, AHintNeverChangesTheAnswer) {
   Rng rng(33, 0);
   int clear = 0, blocked = 0;
@@ -244,10 +245,19 @@ TEST(OccluderIndex, AHintNeverChangesTheAnswer) {
     addRandomTriangles(d, rng, 4, 3.0f, 1.0f);
     auto s = Scene::build(d);
     const OccluderIndex& index = s->occluders();
+    const io::MeshDesc& mesh = d.meshes.back();
     for (int q = 0; q < 200; ++q) {
       Vec3 apex = uniformIn(rng, Vec3(-5.0f), Vec3(5.0f));
       Vec3 c = uniformIn(rng, Vec3(-5.0f), Vec3(5.0f)), h = uniformIn(rng, Vec3(0.0f), Vec3(1.0f));
       if (q % 7 == 0) h.y = 0;  // flat boxes too
+      if (q % 4 == 3) {
+        // Lights on a triangle, seen from in front of it: the segments end short of it.
+        const auto& t = mesh.triangles[size_t(q / 4) % mesh.triangles.size()];
+        const Vec3 a = mesh.points[size_t(t[0])], b = mesh.points[size_t(t[1])], e = mesh.points[size_t(t[2])];
+        c = (a + b + e) / 3.0f;
+        h = Vec3(0.02f);
+        apex = c + normalize(cross(b - a, e - a)) * (0.5f + 2 * rng.uniform());
+      }
       const float shortfall = q % 3 == 0 ? 0.0f : q % 3 == 1 ? 0.01f : 0.5f;
       const int skip = q % 5 == 0 ? int(rng.uniform() * 10) : -1;
       const bool expected = index.clear(apex, c - h, c + h, 1e-5f, shortfall, skip);
