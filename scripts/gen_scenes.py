@@ -188,7 +188,8 @@ def light_text(p, col, power, spot=None):
 
 
 def box(center, size, mat, rot_y=0.0, rot_z=0.0):
-    """An axis-aligned box quadric, or one rotated about z, then about y (degrees)."""
+    """An axis-aligned box quadric, or one rotated about z, then about y (radians, as the .ray
+    format's rotate takes them: callers that wrote degrees get some other turn)."""
     s = f"scale({num(size[0])}, {num(size[1])}, {num(size[2])}, box {{ material = {mat}; }})"
     if rot_z:
         s = f"rotate(0, 0, 1, {num(rot_z)}, {s})"
