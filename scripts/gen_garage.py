@@ -17,7 +17,7 @@ import random
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gen_scenes import box, material  # noqa: E402
+from gen_scenes import box, material, room_shell  # noqa: E402
 
 
 def main(argv):
@@ -29,12 +29,7 @@ def main(argv):
          "camera { position = (-13.5, 1.6, 6.6); look_at = (6, 0.9, 1.5); aspectratio = 1.5; fov = 62; }\n"]
     conc = material(diffuse=(0.55, 0.55, 0.55))
     floor = material(diffuse=(0.35, 0.35, 0.36), specular=(0.15, 0.15, 0.15), shininess=30)
-    L.append(box((0, -0.05, 0), (W, 0.1, D), floor))
-    L.append(box((0, H + 0.05, 0), (W, 0.1, D), conc))
-    for x in (-1, 1):
-        L.append(box((x * (W / 2 + 0.05), H / 2, 0), (0.1, H, D), conc))
-    for z in (-1, 1):
-        L.append(box((0, H / 2, z * (D / 2 + 0.05)), (W, H, 0.1), conc))
+    L += room_shell(W, H, D, floor, conc)
     L.append(box((6, 0.6, -6.3), (10, 1.2, 0.25), conc))  # the ramp's wall
     L.append(box((-8, H / 2, -6.3), (3, H, 2.5), material(diffuse=(0.6, 0.5, 0.4))))  # stair core
     for i in range(-2, 3):  # columns

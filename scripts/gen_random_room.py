@@ -15,7 +15,7 @@ import random
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gen_scenes import box, light_text, material, num  # noqa: E402
+from gen_scenes import box, light_text, material, num, room_shell  # noqa: E402
 
 TOTAL_POWER = 300.0  # summed intensity of the point lights (each channel), whatever N
 
@@ -32,12 +32,7 @@ def main(argv):
          f"look_at = ({num(W * 0.2)}, {num(H * 0.3)}, {num(-D * 0.3)}); aspectratio = 1.5; fov = 60; }}\n"]
     wall = material(diffuse=(0.7, 0.68, 0.65))
     floor = material(diffuse=(0.45, 0.4, 0.35), specular=(0.3, 0.3, 0.3), shininess=40)
-    L.append(box((0, -0.05, 0), (W, 0.1, D), floor))
-    L.append(box((0, H + 0.05, 0), (W, 0.1, D), wall))
-    for x in (-1, 1):
-        L.append(box((x * (W / 2 + 0.05), H / 2, 0), (0.1, H, D), wall))
-    for z in (-1, 1):
-        L.append(box((0, H / 2, z * (D / 2 + 0.05)), (W, H, 0.1), wall))
+    L += room_shell(W, H, D, floor, wall)
     rgb = lambda lo, hi: tuple(rng.uniform(lo, hi) for _ in range(3))  # noqa: E731
     for _ in range(rng.randint(2, 4)):  # partitions, with gaps around them
         x = rng.uniform(-W / 3, W / 3)

@@ -198,6 +198,17 @@ def box(center, size, mat, rot_y=0.0, rot_z=0.0):
     return f"translate({num(center[0])}, {num(center[1])}, {num(center[2])}, {s})\n"
 
 
+def room_shell(W, H, D, floor, wall):
+    """A closed room of W x H x D (x, y, z) around the origin, standing on y = 0: the floor,
+    the ceiling and four walls as boxes 0.1 thick outside it, in that order."""
+    out = [box((0, -0.05, 0), (W, 0.1, D), floor), box((0, H + 0.05, 0), (W, 0.1, D), wall)]
+    for x in (-1, 1):
+        out.append(box((x * (W / 2 + 0.05), H / 2, 0), (0.1, H, D), wall))
+    for z in (-1, 1):
+        out.append(box((0, H / 2, z * (D / 2 + 0.05)), (W, H, 0.1), wall))
+    return out
+
+
 def cylinder_y(base, radius, height, mat, capped=True):
     """A cylinder standing on `base`, along +y."""
     cap = "" if capped else " capped = false;"

@@ -22,6 +22,22 @@ Vec3 uniformIn(Rng& rng, const Vec3& lo, const Vec3& hi) {
   return lo + (hi - lo) * Vec3(rng.uniform(), rng.uniform(), rng.uniform());
 }
 
+// Adds to d `count` shapes, of each kind in turn, centred within `spread` of the origin,
+// scaled by `minScale` plus up to 1 along each axis and turned about a random axis (only
+// every other one unless `turnAll`: shapes aligned with the world's axes are a case of
+// their own).
+void addRandomShapes(io::SceneDesc& d, Rng& rng, int count, float spread, float minScale, bool turnAll) {
+  for (int k = 0; k < count; ++k) {
+    Vec3 c = uniformIn(rng, Vec3(-spread), Vec3(spread));
+    Mat4 m = Mat4::translate(c.x, c.y, c.z) *
+             (turnAll || k % 2 ? Mat4::rotate(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5,
+                                              6.28 * rng.uniform())
+                               : Mat4::identity()) *
+             Mat4::scale(minScale + rng.uniform(), minScale + rng.uniform(), minScale + rng.uniform());
+    d.objects.push_back(object(ShapeKind(k % 5), m));
+  }
+}
+
 // Adds to d one mesh object of `count` random triangles, each with its corners within
 // `size` of a centre in [-spread, spread]^3.
 void addRandomTriangles(io::SceneDesc& d, Rng& rng, int count, float spread, float size) {
@@ -35,6 +51,21 @@ void addRandomTriangles(io::SceneDesc& d, Rng& rng, int count, float spread, flo
   mo.mesh = int(d.meshes.size());
   d.meshes.push_back(std::move(mesh));
   d.objects.push_back(mo);
+}
+
+// A scene of `shapes` random shapes (addRandomShapes) and `triangles` random triangles of
+// up to a unit's size, all within `spread` of the origin.
+struct RandomScene {
+  io::SceneDesc desc;
+  std::unique_ptr<Scene> scene;
+};
+RandomScene randomScene(Rng& rng, int shapes, float spread, float minScale, bool turnAll, int triangles) {
+  RandomScene r;
+  r.desc.materials.emplace_back();
+  addRandomShapes(r.desc, rng, shapes, spread, minScale, turnAll);
+  addRandomTriangles(r.desc, rng, triangles, spread, 1.0f);
+  r.scene = Scene::build(r.desc);
+  return r;
 }
 
 // Whether a "clear" answer holds: the segments from the apex to the box's corners and to
@@ -62,18 +93,9 @@ TEST(OccluderIndex, ClearSegmentsMeetNoSurface) {
   Rng rng(21, 0);
   int clear = 0, blocked = 0;
   for (int sceneIndex = 0; sceneIndex < 12; ++sceneIndex) {
-    io::SceneDesc d;
-    d.materials.emplace_back();
-    for (int k = 0; k < 6; ++k) {
-      Vec3 c = uniformIn(rng, Vec3(-4.0f), Vec3(4.0f));
-      Mat4 m = Mat4::translate(c.x, c.y, c.z) *
-               Mat4::rotate(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5, 6.28 * rng.uniform()) *
-               Mat4::scale(0.3 + rng.uniform(), 0.3 + rng.uniform(), 0.3 + rng.uniform());
-      d.objects.push_back(object(ShapeKind(k % 5), m));
-    }
-    addRandomTriangles(d, rng, 6, 4.0f, 1.0f);
-    auto s = Scene::build(d);
-    const OccluderIndex& index = s->occluders();
+    const RandomScene r = randomScene(rng, 6, 4.0f, 0.3f, true, 6);
+    const Scene& s = *r.scene;
+    const OccluderIndex& index = s.occluders();
     ASSERT_EQ(index.pieceCount(), 6u + 6u);
     for (int q = 0; q < 300; ++q) {
       Vec3 apex = uniformIn(rng, Vec3(-6.0f), Vec3(6.0f));
@@ -84,7 +106,7 @@ TEST(OccluderIndex, ClearSegmentsMeetNoSurface) {
         continue;
       }
       ++clear;
-      ASSERT_TRUE(segmentsClear(*s, rng, apex, c, h, shortfall, 72)) << "scene " << sceneIndex << " query " << q;
+      ASSERT_TRUE(segmentsClear(s, rng, apex, c, h, shortfall, 72)) << "scene " << sceneIndex << " query " << q;
     }
   }
   EXPECT_GT(clear, 300);
@@ -232,20 +254,9 @@ TEST(OccluderIndex, AHintNeverChangesTheAnswer) {
   Rng rng(33, 0);
   int clear = 0, blocked = 0;
   for (int sceneIndex = 0; sceneIndex < 8; ++sceneIndex) {
-    io::SceneDesc d;
-    d.materials.emplace_back();
-    for (int k = 0; k < 10; ++k) {
-      Vec3 c = uniformIn(rng, Vec3(-3.0f), Vec3(3.0f));
-      Mat4 m = Mat4::translate(c.x, c.y, c.z) *
-               (k % 2 ? Mat4::rotate(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5, 6.28 * rng.uniform())
-                      : Mat4::identity()) *
-               Mat4::scale(0.2 + rng.uniform(), 0.2 + rng.uniform(), 0.2 + rng.uniform());
-      d.objects.push_back(object(ShapeKind(k % 5), m));
-    }
-    addRandomTriangles(d, rng, 4, 3.0f, 1.0f);
-    auto s = Scene::build(d);
-    const OccluderIndex& index = s->occluders();
-    const io::MeshDesc& mesh = d.meshes.back();
+    const RandomScene r = randomScene(rng, 10, 3.0f, 0.2f, false, 4);
+    const OccluderIndex& index = r.scene->occluders();
+    const io::MeshDesc& mesh = r.desc.meshes.back();
     for (int q = 0; q < 200; ++q) {
       Vec3 apex = uniformIn(rng, Vec3(-5.0f), Vec3(5.0f));
       Vec3 c = uniformIn(rng, Vec3(-5.0f), Vec3(5.0f)), h = uniformIn(rng, Vec3(0.0f), Vec3(1.0f));
