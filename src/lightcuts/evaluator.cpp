@@ -639,7 +639,13 @@ class Lightcuts final : public LightEvaluator {
           continue;
         }
       }
-      const CutNode cn = popped;
+      // Read in place (a copy was 1.2% of the room's cut): this refinement adds two nodes,
+      // so room for them is made first and `nodes` does not move under the reference.
+      if (nodes.capacity() < nodes.size() + 2) {
+        nodes.reserve(2 * nodes.capacity() + 2);
+        secondLum.reserve(2 * secondLum.capacity() + 2);
+      }
+      const CutNode& cn = nodes[uint32_t(top)];
       double& sum = cn.scaled ? sumScaled : sumSq;
       sum = std::max(0.0, sum - double(cn.spread) * cn.spread);
       coins.add(cn.lights, -double(cn.hideable));
@@ -676,11 +682,13 @@ class Lightcuts final : public LightEvaluator {
         // The child that shares the parent's representative reuses its shadow ray; in a
         // clear cluster no child needs one. Only clusters that may be probed need to know
         // what hid their representative.
-        shadows[k] = cn.shadow;
-        units[k] = rep == cn.rep ? cn.unit
-                                 : shadowedUnit(lights_.lights[rep], lights_.groups[lights_.lights[rep].group], sp,
-                                                vis, stats, shadows[k],
-                                                probes && tree.lightCount(c) >= kProbeMinLights, cnClear);
+        if (rep == cn.rep) {
+          shadows[k] = cn.shadow;
+          units[k] = cn.unit;
+        } else {
+          units[k] = shadowedUnit(lights_.lights[rep], lights_.groups[lights_.lights[rep].group], sp, vis, stats,
+                                  shadows[k], probes && tree.lightCount(c) >= kProbeMinLights, cnClear);
+        }
       }
       // A shadow boundary: one child's representative is hidden, the other's not (never in
       // a clear cluster, whose refinements count in the boundary rate as their rays would
