@@ -341,15 +341,11 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
   return hull.coneApart(b) || hull.triangleApart(v) || hull.silhouetteApart(b);
 }
 
-// A quadric: a point X of a segment of the query inside the piece's bounding box (and, for a
-// rotated quadric, within its extent along each of its axes) lies on both sides of every plane and
-// cone pieceApart could separate them by, so pieceApart answers no. The segments toward the
-// box's eight corners are clipped to the piece's box (and a rotated quadric's own slabs) four
-// at a time (in SSE lanes);
-// a segment that keeps a part is checked at that part's midpoint, as computed, so that no
-// rounding of the clipping makes a witness of a point outside. Each segment ends at most
-// `shortfall` short of its corner: by the largest of |d|'s components, not its length, which
-// ends it no later than its length would.
+// A point of a segment of the query that lies in the piece as pieceApart sees it (see the
+// header) is on both sides of every plane and cone pieceApart could separate the two by, so
+// pieceApart answers no. Each segment, toward one of the box's eight corners, ends at least
+// `shortfall` short of it: by the largest of its components rather than its length, which
+// ends it no later than the length would.
 bool OccluderIndex::onSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi, float margin, float shortfall,
                                const Piece& p, int skip) const {
   if (int(p.shape) == skip) return false;
@@ -388,6 +384,10 @@ bool OccluderIndex::onSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi,
     }
     return false;
   }
+  // A quadric as pieceApart sees it: its bounding box and, rotated, its extent along each of
+  // its axes. The segments are clipped to those slabs four at a time (SSE lanes), and one
+  // that keeps a part is checked at that part's midpoint, as computed, so that no rounding of
+  // the clipping makes a witness of a point outside.
   const QuadricAxes& q = quadrics_[p.shape];
   const Bounds3& b = q.box;
   // Every segment lies in the box around the apex and the query's box: a piece outside it
