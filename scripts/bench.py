@@ -10,8 +10,9 @@ and writes the generated section of docs/BENCHMARKS.md and the images docs/image
 Environment: BUILD (build folder, default `build`), BENCH_QUICK=1 (same as --quick).
 
 Full mode writes docs/BENCHMARKS.md and docs/images/ (about an hour on 2 cores);
-quick mode (small images, one run each; about half an hour on 2 cores, the suite having grown) writes out/bench-quick/BENCHMARKS.md and
-out/bench-quick/images/ and leaves docs/ alone unless --docs is given. Raw renders, --stats
+quick mode (small images, one run each; about half an hour on 2 cores) writes
+out/bench-quick/BENCHMARKS.md and out/bench-quick/images/ and leaves docs/ alone unless --docs
+is given. Raw renders, --stats
 files, logs and results.json go to out/bench/ (or out/bench-quick/); --resume reuses the parts
 already in results.json (same commit) instead of measuring them again; --write-only
 regenerates the Markdown and images from results.json. A partial run (--only ROW ...) at full
