@@ -641,10 +641,7 @@ class Lightcuts final : public LightEvaluator {
       }
       // Read in place (a copy was 1.2% of the room's cut): this refinement adds two nodes,
       // so room for them is made first and `nodes` does not move under the reference.
-      if (nodes.capacity() < nodes.size() + 2) {
-        nodes.reserve(2 * nodes.capacity() + 2);
-        secondLum.reserve(2 * secondLum.capacity() + 2);
-      }
+      if (nodes.capacity() < nodes.size() + 2) nodes.reserve(2 * nodes.capacity() + 2);
       const CutNode& cn = nodes[uint32_t(top)];
       double& sum = cn.scaled ? sumScaled : sumSq;
       sum = std::max(0.0, sum - double(cn.spread) * cn.spread);

@@ -349,37 +349,47 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
 bool OccluderIndex::onSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi, float margin, float shortfall,
                                const Piece& p, int skip) const {
   if (int(p.shape) == skip) return false;
-  auto corner = [&](int k) { return Vec3((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z); };
   const Shape& shape = (*shapes_)[p.shape];
-  if (shape.kind == ShapeKind::Mesh) {
+  const bool triangle = shape.kind == ShapeKind::Mesh;
+  Vec3 v[3];
+  Bounds3 b;
+  if (triangle) {
+    const Mesh& m = (*meshes_)[size_t(shape.mesh)];
+    const auto& tri = m.triangles[p.prim];
+    for (int i = 0; i < 3; ++i) v[i] = m.positions[size_t(tri[i])];
+    b = Bounds3(v[0], v[1]);
+    b.extend(v[2]);
+  } else {
+    b = quadrics_[p.shape].box;
+  }
+  // Every segment lies in the box around the apex and the query's box: a piece outside it
+  // has no point on them (and pieceApart will say so at once).
+  const Vec3 slo = vmin(apex, lo), shi = vmax(apex, hi);
+  if (b.hi.x < slo.x || b.lo.x > shi.x || b.hi.y < slo.y || b.lo.y > shi.y || b.hi.z < slo.z || b.lo.z > shi.z)
+    return false;
+  // Whether x lies in the piece's box, widened by `slack`.
+  auto inBox = [&](const Vec3& x, float slack) {
+    return x.x >= b.lo.x - slack && x.x <= b.hi.x + slack && x.y >= b.lo.y - slack && x.y <= b.hi.y + slack &&
+           x.z >= b.lo.z - slack && x.z <= b.hi.z + slack;
+  };
+  auto corner = [&](int k) { return Vec3((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z); };
+  if (triangle) {
     // A triangle: a segment that crosses it inside (by kInside of its barycentric
     // coordinates, beyond their rounding), at a point within half the margin of the
     // triangle's bounding box as computed (a flat triangle's box has no depth): the box,
     // plane, cone, edge-plane and silhouette tests of pieceApart all have it on both sides.
     constexpr float kInside = 1e-4f;
-    const Mesh& m = (*meshes_)[size_t(shape.mesh)];
-    const auto& tri = m.triangles[p.prim];
-    const Vec3 v0 = m.positions[size_t(tri[0])], v1 = m.positions[size_t(tri[1])], v2 = m.positions[size_t(tri[2])];
-    Bounds3 b(v0, v1);
-    b.extend(v2);
-    const Vec3 slo = vmin(apex, lo), shi = vmax(apex, hi);
-    if (b.hi.x < slo.x || b.lo.x > shi.x || b.hi.y < slo.y || b.lo.y > shi.y || b.hi.z < slo.z || b.lo.z > shi.z)
-      return false;
-    const Vec3 e1 = v1 - v0, e2 = v2 - v0, s0 = apex - v0, qv = cross(s0, e1);
-    const float slack = 0.5f * margin;
+    const Vec3 e1 = v[1] - v[0], e2 = v[2] - v[0], s0 = apex - v[0], qv = cross(s0, e1);
     for (int k = 0; k < 8; ++k) {
       const Vec3 d = corner(k) - apex;
-      const float dm = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+      const float dm = maxComponent(vabs(d));
       const Vec3 pv = cross(d, e2);
       const float det = dot(e1, pv);
       if (!(std::fabs(det) > 0) || !(dm > 0)) continue;
       const float inv = 1 / det;
-      const float u = dot(s0, pv) * inv, v = dot(d, qv) * inv, t = dot(e2, qv) * inv;
-      if (!(u >= kInside && v >= kInside && u + v <= 1 - kInside && t >= kInside && t <= 1 - shortfall / dm - kInside))
-        continue;
-      const Vec3 x = apex + d * t;
-      if (x.x >= b.lo.x - slack && x.x <= b.hi.x + slack && x.y >= b.lo.y - slack && x.y <= b.hi.y + slack &&
-          x.z >= b.lo.z - slack && x.z <= b.hi.z + slack)
+      const float u = dot(s0, pv) * inv, w = dot(d, qv) * inv, t = dot(e2, qv) * inv;
+      if (u >= kInside && w >= kInside && u + w <= 1 - kInside && t >= kInside &&
+          t <= 1 - shortfall / dm - kInside && inBox(apex + d * t, 0.5f * margin))
         return true;
     }
     return false;
@@ -389,15 +399,8 @@ bool OccluderIndex::onSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi,
   // that keeps a part is checked at that part's midpoint, as computed, so that no rounding of
   // the clipping makes a witness of a point outside.
   const QuadricAxes& q = quadrics_[p.shape];
-  const Bounds3& b = q.box;
-  // Every segment lies in the box around the apex and the query's box: a piece outside it
-  // has no point on them (and pieceApart will say so at once).
-  const Vec3 slo = vmin(apex, lo), shi = vmax(apex, hi);
-  if (b.hi.x < slo.x || b.lo.x > shi.x || b.hi.y < slo.y || b.lo.y > shi.y || b.hi.z < slo.z || b.lo.z > shi.z)
-    return false;
   auto inside = [&](const Vec3& x) {
-    if (!(x.x >= b.lo.x && x.x <= b.hi.x && x.y >= b.lo.y && x.y <= b.hi.y && x.z >= b.lo.z && x.z <= b.hi.z))
-      return false;
+    if (!inBox(x, 0)) return false;
     for (int k = 0; k < q.axes; ++k) {
       const float d = dot(q.axis[k], x);
       if (!(d >= q.lo[k] && d <= q.hi[k])) return false;
@@ -444,8 +447,7 @@ bool OccluderIndex::onSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi,
 #else
   for (int k = 0; k < 8; ++k) {
     const Vec3 d = corner(k) - apex;
-    const float m = std::max({std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
-    float t0 = 0, t1 = 1 - shortfall / m;
+    float t0 = 0, t1 = 1 - shortfall / maxComponent(vabs(d));
     auto slab = [&](float dn, float a, float blo, float bhi) {
       const float ta = (blo - a) / dn, tb = (bhi - a) / dn;
       if (!std::isnan(ta) && !std::isnan(tb)) {
