@@ -274,6 +274,11 @@ nlohmann::json renderStatsJson(const RenderReport& r) {
                       {"fraction_over_threshold", ref.fractionOver2pct},
                       {"threshold", render::ReferenceStats::kThreshold},
                       {"brute_lights_per_shading_point", ref.bruteLightsPerShadingPoint}};
+    nlohmann::json worst = nlohmann::json::array();
+    for (const render::ReferenceStats::Pixel& p : ref.worst)
+      worst.push_back({{"x", p.x}, {"y", p.y}, {"reference", p.reference}, {"test", p.test},
+                       {"relative_error", p.relativeError}});
+    j["reference"]["worst_pixels"] = worst;
   }
   if (r.perRank)
     j["mpi"] = {{"ranks", r.ranks}, {"load_balance", r.loadBalance}, {"per_rank", *r.perRank}};
@@ -356,8 +361,9 @@ void printRenderSummary(const RenderReport& r) {
     double speedup = rr.stats.seconds > 0 ? ref.bruteSecondsEstimate / rr.stats.seconds : 0;
     fmt::print("reference  brute force at {} pixels: {:.1f} lights per point; full image would take ~{} -> speed-up ~{:.1f}x\n",
                ref.pixels, ref.bruteLightsPerShadingPoint, formatSeconds(ref.bruteSecondsEstimate), speedup);
-    fmt::print("error      mean {:.2f}%, p99 {:.2f}%, max {:.2f}%, {:.2f}% of sampled pixels over 2%\n",
+    fmt::print("error      mean {:.2f}%, p99 {:.2f}%, max {:.2f}%{}, {:.2f}% of sampled pixels over 2%\n",
                100 * ref.meanRelativeError, 100 * ref.p99RelativeError, 100 * ref.maxRelativeError,
+               ref.worst.empty() ? std::string() : fmt::format(" at pixel ({}, {})", ref.worst[0].x, ref.worst[0].y),
                100 * ref.fractionOver2pct);
   }
 }

@@ -105,6 +105,17 @@ void measureReference(const scene::Scene& scene, const lightcuts::LightEvaluator
   std::vector<double> rel(px.size());
   for (size_t i = 0; i < px.size(); ++i)
     rel[i] = io::relativeError(double(luminance(ref[i])), double(luminance(test[i])), floor);
+  std::vector<size_t> order(px.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const size_t shown = std::min(order.size(), ReferenceStats::kWorstPixels);
+  // Worst first; ties in pixel order, so the list is the same at any thread count.
+  std::partial_sort(order.begin(), order.begin() + ptrdiff_t(shown), order.end(),
+                    [&](size_t a, size_t b) { return rel[a] > rel[b] || (rel[a] == rel[b] && a < b); });
+  res.stats.reference.worst.clear();
+  for (size_t k = 0; k < shown; ++k) {
+    const size_t i = order[k];
+    res.stats.reference.worst.push_back({px[i].first, px[i].second, luminance(ref[i]), luminance(test[i]), rel[i]});
+  }
   std::sort(rel.begin(), rel.end());
   double sum = 0;
   size_t over = 0;

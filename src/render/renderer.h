@@ -192,6 +192,15 @@ struct ReferenceStats {
   // The relative error that fractionOver2pct counts beyond (--stats: threshold).
   static constexpr double kThreshold = 0.02;
   double bruteLightsPerShadingPoint = 0;
+  // The worst pixels, worst first (at most kWorstPixels; --stats: worst_pixels): where to
+  // look in the image.
+  struct Pixel {
+    int x = 0, y = 0;
+    float reference = 0, test = 0;  // luminance
+    double relativeError = 0;
+  };
+  static constexpr size_t kWorstPixels = 16;
+  std::vector<Pixel> worst;
 };
 
 // --error-floor auto: half the image metric's floor (1% of the mean luminance), estimated
