@@ -165,6 +165,7 @@ void expectSameImages(const Variant& v) {
       EXPECT_EQ(j["reference"]["pixels"], one["reference"]["pixels"]);
       EXPECT_EQ(j["reference"]["mean_relative_error"], one["reference"]["mean_relative_error"]);
       EXPECT_EQ(j["reference"]["max_relative_error"], one["reference"]["max_relative_error"]);
+      EXPECT_EQ(j["reference"]["worst_pixels"], one["reference"]["worst_pixels"]);
       EXPECT_EQ(j["reference"]["brute_lights_per_shading_point"], one["reference"]["brute_lights_per_shading_point"]);
     }
     // Without reconstruction cuts no pixel is traced twice: the counters add up exactly.
