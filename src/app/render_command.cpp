@@ -689,8 +689,9 @@ void addRenderCommand(CLI::App& app) {
                         lightcuts::kSecondSampleShare, switchName(d.secondSamples)))
       ->group(cuts);
   c->add_option("--reference-pixels", a->referencePixels,
-                fmt::format("Also run brute force at K pixels: report the measured error and the estimated "
-                            "brute-force time; default {} (none)", d.referencePixels))
+                fmt::format("Also run brute force at K pixels: report the measured error, the worst pixels (--stats: "
+                            "reference.worst_pixels) and the estimated brute-force time; default {} (none)",
+                            d.referencePixels))
       ->check(CLI::Range(0, 1 << 24))
       ->group(cuts);
   c->add_option("--reconstruct", a->reconstruct,
