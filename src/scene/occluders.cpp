@@ -258,14 +258,19 @@ OccluderIndex::OccluderIndex(const std::vector<Shape>& shapes, const std::vector
   pieces_.swap(sorted);
 }
 
-Bounds3 OccluderIndex::pieceBox(const Piece& p) const {
-  const Shape& s = (*shapes_)[p.shape];
-  if (s.kind != ShapeKind::Mesh) return quadrics_[p.shape].box;
-  const Mesh& m = (*meshes_)[size_t(s.mesh)];
+Bounds3 OccluderIndex::triangle(const Piece& p, Vec3 v[3]) const {
+  const Mesh& m = (*meshes_)[size_t((*shapes_)[p.shape].mesh)];
   const auto& tri = m.triangles[p.prim];
-  Bounds3 b(m.positions[size_t(tri[0])], m.positions[size_t(tri[1])]);
-  b.extend(m.positions[size_t(tri[2])]);
+  for (int i = 0; i < 3; ++i) v[i] = m.positions[size_t(tri[i])];
+  Bounds3 b(v[0], v[1]);
+  b.extend(v[2]);
   return b;
+}
+
+Bounds3 OccluderIndex::pieceBox(const Piece& p) const {
+  if ((*shapes_)[p.shape].kind != ShapeKind::Mesh) return quadrics_[p.shape].box;
+  Vec3 v[3];
+  return triangle(p, v);
 }
 
 // Fills node `self` for the pieces order[begin, end): a leaf, or a split at the median
@@ -320,13 +325,10 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
       if (hull.axisApart(q.axis[k], q.lo[k], q.hi[k])) return true;
     return hull.silhouetteApart(q.box);
   }
-  const Mesh& m = (*meshes_)[size_t(s.mesh)];
-  const auto& tri = m.triangles[p.prim];
-  const Vec3 v[3] = {m.positions[size_t(tri[0])], m.positions[size_t(tri[1])], m.positions[size_t(tri[2])]};
+  Vec3 v[3];
   // The triangle is within its vertices' box exactly (the margin covers the hit test's
   // rounding), so the box needs no padding. The cheap tests first: the box, the plane.
-  Bounds3 b(v[0], v[1]);
-  b.extend(v[2]);
+  const Bounds3 b = triangle(p, v);
   if (hull.aabbApart(b)) return true;
   // Its plane: the triangle's extent along its normal (one value, padded for rounding).
   Vec3 n = cross(v[1] - v[0], v[2] - v[0]);
@@ -349,19 +351,9 @@ bool OccluderIndex::pieceApart(const Hull& hull, const Piece& p, int skip) const
 bool OccluderIndex::onSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi, float margin, float shortfall,
                                const Piece& p, int skip) const {
   if (int(p.shape) == skip) return false;
-  const Shape& shape = (*shapes_)[p.shape];
-  const bool triangle = shape.kind == ShapeKind::Mesh;
+  const bool flat = (*shapes_)[p.shape].kind == ShapeKind::Mesh;
   Vec3 v[3];
-  Bounds3 b;
-  if (triangle) {
-    const Mesh& m = (*meshes_)[size_t(shape.mesh)];
-    const auto& tri = m.triangles[p.prim];
-    for (int i = 0; i < 3; ++i) v[i] = m.positions[size_t(tri[i])];
-    b = Bounds3(v[0], v[1]);
-    b.extend(v[2]);
-  } else {
-    b = quadrics_[p.shape].box;
-  }
+  const Bounds3 b = flat ? triangle(p, v) : quadrics_[p.shape].box;
   // Every segment lies in the box around the apex and the query's box: a piece outside it
   // has no point on them (and pieceApart will say so at once).
   const Vec3 slo = vmin(apex, lo), shi = vmax(apex, hi);
@@ -373,7 +365,7 @@ bool OccluderIndex::onSegments(const Vec3& apex, const Vec3& lo, const Vec3& hi,
            x.z >= b.lo.z - slack && x.z <= b.hi.z + slack;
   };
   auto corner = [&](int k) { return Vec3((k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z); };
-  if (triangle) {
+  if (flat) {
     // A triangle: a segment that crosses it inside (by kInside of its barycentric
     // coordinates, beyond their rounding), at a point within half the margin of the
     // triangle's bounding box as computed (a flat triangle's box has no depth): the box,

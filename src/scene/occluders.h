@@ -73,6 +73,8 @@ class OccluderIndex {
     uint32_t first = 0, count = 0;
   };
   Bounds3 pieceBox(const Piece& p) const;
+  // A triangle piece's vertices into v, and their box.
+  Bounds3 triangle(const Piece& p, Vec3 v[3]) const;
   bool pieceApart(const detail::Hull& hull, const Piece& p, int skip) const;
   // Whether a segment of the query (from the apex toward a corner of the box, ending
   // `shortfall` before it) runs through piece p as pieceApart sees it: then pieceApart would
